@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Installs what rtcl needs to build, test and benchmark on Debian 12 (run as root).
+# Idempotent: installs only packages that are missing.
+set -euo pipefail
+packages=(
+  build-essential cmake pkg-config ninja-build
+  opencl-headers opencl-clhpp-headers ocl-icd-opencl-dev pocl-opencl-icd clinfo
+  libglm-dev libopenimageio-dev openimageio-tools libassimp-dev nlohmann-json3-dev libcli11-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libembree-dev python3
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "setup: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi

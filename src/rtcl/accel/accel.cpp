@@ -1,0 +1,57 @@
+#include "rtcl/accel/accel.hpp"
+
+#include "rtcl/layouts.hpp"
+
+namespace rtcl {
+
+Accel::Accel(const Device& device, std::string name, const std::string& kernel_file, std::vector<std::string> defines,
+             AccelStats stats)
+    : device_(device), name_(std::move(name)), stats_(stats) {
+  cl::Program program = device_.program(kernel_file, defines);
+  // "accel/bvh.cl" defines trace_closest_bvh and trace_any_bvh
+  std::string stem = kernel_file.substr(kernel_file.rfind('/') + 1);
+  stem = stem.substr(0, stem.rfind('.'));
+  with_cl_errors([&] {
+    closest_ = cl::Kernel(program, ("trace_closest_" + stem).c_str());
+    any_ = cl::Kernel(program, ("trace_any_" + stem).c_str());
+  });
+}
+
+cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hits, std::size_t ray_count,
+                       const std::vector<cl::Event>& wait) const {
+  return with_cl_errors([&] {
+    if (ray_count > 0xffffffffu) throw Error(name_ + " trace: ray_count " + std::to_string(ray_count) + " exceeds 2^32-1");
+    std::size_t ray_bytes = rays.getInfo<CL_MEM_SIZE>(), hit_bytes = hits.getInfo<CL_MEM_SIZE>();
+    if (ray_bytes < ray_count * sizeof(Ray))
+      throw Error(name_ + " trace: ray buffer holds " + std::to_string(ray_bytes / sizeof(Ray)) + " rays, " +
+                  std::to_string(ray_count) + " requested");
+    if (hit_bytes < ray_count * sizeof(Hit))
+      throw Error(name_ + " trace: hit buffer holds " + std::to_string(hit_bytes / sizeof(Hit)) + " hits, " +
+                  std::to_string(ray_count) + " requested");
+    cl::Kernel& kernel = query == Query::closest ? closest_ : any_;
+    if (!args_set_) {
+      set_structure_args(closest_, 3);
+      set_structure_args(any_, 3);
+      args_set_ = true;
+    }
+    kernel.setArg(0, rays);
+    kernel.setArg(1, hits);
+    kernel.setArg(2, static_cast<cl_uint>(ray_count));
+    cl::Event done;
+    if (ray_count == 0) {
+      device_.queue().enqueueMarkerWithWaitList(&wait, &done);
+      return done;
+    }
+    device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(ray_count), cl::NullRange,
+                                         wait.empty() ? nullptr : &wait, &done);
+    return done;
+  });
+}
+
+std::vector<std::string> primitive_defines(const Geometry& geometry) {
+  std::vector<std::string> defines;
+  if (!geometry.spheres.empty()) defines.push_back("RTCL_HAS_SPHERES");
+  return defines;
+}
+
+}  // namespace rtcl

@@ -1,0 +1,56 @@
+// Brute force: all primitives in id order, tested eight at a time. The
+// device-side reference every other structure is compared with.
+#include "rtcl/accel/brute.hpp"
+
+#include <chrono>
+
+#include "rtcl/accel/primitive_blocks.hpp"
+
+namespace rtcl {
+
+namespace {
+
+class BruteAccel final : public Accel {
+ public:
+  BruteAccel(const Device& device, const Geometry& geometry, PrimitiveBlocks blocks, AccelStats stats)
+      : Accel(device, "brute", "accel/brute.cl", primitive_defines(geometry), stats),
+        primitives_(upload(device, blocks)),
+        triangle_blocks_(static_cast<cl_uint>(blocks.triangles.size())),
+        sphere_blocks_(static_cast<cl_uint>(blocks.spheres.size())) {}
+
+ private:
+  void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
+    kernel.setArg(first, primitives_.triangles);
+    kernel.setArg(first + 1, triangle_blocks_);
+    kernel.setArg(first + 2, primitives_.spheres);
+    kernel.setArg(first + 3, sphere_blocks_);
+  }
+
+  DevicePrimitives primitives_;
+  cl_uint triangle_blocks_, sphere_blocks_;
+};
+
+}  // namespace
+
+std::unique_ptr<Accel> make_brute(const Device& device, const Geometry& geometry) {
+  auto start = std::chrono::steady_clock::now();
+  GeometryReport report = validate(geometry);
+  std::vector<std::uint32_t> ids = stored_primitives(geometry);
+  PrimitiveBlocks blocks;
+  std::size_t first_sphere = ids.size() - geometry.spheres.size();
+  for (std::size_t begin = 0; begin < ids.size();) {
+    std::size_t kind_end = begin < first_sphere ? first_sphere : ids.size();
+    std::size_t end = std::min(begin + RTCL_BLOCK_WIDTH, kind_end);
+    blocks.append(geometry, std::span(ids).subspan(begin, end - begin));
+    begin = end;
+  }
+  AccelStats stats;
+  stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats.device_bytes = blocks.bytes();
+  stats.primitive_count = ids.size();
+  stats.zero_area_skipped = report.zero_area_triangles;
+  stats.leaf_count = blocks.triangles.size() + blocks.spheres.size();
+  return std::make_unique<BruteAccel>(device, geometry, std::move(blocks), stats);
+}
+
+}  // namespace rtcl

@@ -1,0 +1,12 @@
+#pragma once
+
+#include <memory>
+
+#include "rtcl/accel/accel.hpp"
+
+namespace rtcl {
+
+// Every ray against every primitive: O(rays x primitives), the reference.
+std::unique_ptr<Accel> make_brute(const Device& device, const Geometry& geometry);
+
+}  // namespace rtcl

@@ -1,0 +1,78 @@
+#include "rtcl/accel/primitive_blocks.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "rtcl/error.hpp"
+
+namespace rtcl {
+
+rtcl_i32 PrimitiveBlocks::append(const Geometry& g, std::span<const std::uint32_t> prims) {
+  if (prims.empty() || prims.size() > RTCL_BLOCK_WIDTH) throw Error("internal: leaf of " + std::to_string(prims.size()) + " primitives");
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  bool spheres_leaf = prims[0] >= g.triangles.size();
+  if (!spheres_leaf) {
+    TriangleBlock b;
+    for (auto& vertex : b.v)
+      for (auto& axis : vertex)
+        for (float& lane : axis) lane = nan;
+    for (int& p : b.prim) p = -1;
+    for (std::size_t lane = 0; lane < prims.size(); ++lane) {
+      if (prims[lane] >= g.triangles.size()) throw Error("internal: mixed leaf");
+      const glm::uvec3& t = g.triangles[prims[lane]];
+      for (int vertex = 0; vertex < 3; ++vertex)
+        for (int axis = 0; axis < 3; ++axis) b.v[vertex][axis][lane] = g.vertices[t[vertex]][axis];
+      b.prim[lane] = static_cast<rtcl_i32>(prims[lane]);
+    }
+    triangles.push_back(b);
+    return RTCL_LEAF_TRIANGLES(triangles.size() - 1);
+  }
+  SphereBlock b;
+  for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+    b.cx[lane] = b.cy[lane] = b.cz[lane] = 0.0f;
+    b.r[lane] = nan;
+    b.prim[lane] = -1;
+  }
+  for (std::size_t lane = 0; lane < prims.size(); ++lane) {
+    if (prims[lane] < g.triangles.size()) throw Error("internal: mixed leaf");
+    const Sphere& s = g.spheres[prims[lane] - g.triangles.size()];
+    b.cx[lane] = s.center.x;
+    b.cy[lane] = s.center.y;
+    b.cz[lane] = s.center.z;
+    b.r[lane] = s.radius;
+    b.prim[lane] = static_cast<rtcl_i32>(prims[lane]);
+  }
+  spheres.push_back(b);
+  return RTCL_LEAF_SPHERES(spheres.size() - 1);
+}
+
+std::size_t PrimitiveBlocks::bytes() const {
+  return triangles.size() * sizeof(TriangleBlock) + spheres.size() * sizeof(SphereBlock);
+}
+
+DevicePrimitives upload(const Device& device, const PrimitiveBlocks& blocks) {
+  DevicePrimitives out;
+  TriangleBlock no_triangle{};
+  SphereBlock no_sphere{};
+  out.triangles = blocks.triangles.empty()
+                      ? device.upload(&no_triangle, sizeof no_triangle, "triangle blocks")
+                      : device.upload(blocks.triangles.data(), blocks.triangles.size() * sizeof(TriangleBlock),
+                                      "triangle blocks");
+  out.spheres = blocks.spheres.empty()
+                    ? device.upload(&no_sphere, sizeof no_sphere, "sphere blocks")
+                    : device.upload(blocks.spheres.data(), blocks.spheres.size() * sizeof(SphereBlock),
+                                    "sphere blocks");
+  out.bytes = blocks.bytes();
+  return out;
+}
+
+std::vector<std::uint32_t> stored_primitives(const Geometry& g) {
+  std::vector<std::uint32_t> ids;
+  ids.reserve(g.primitive_count());
+  for (std::size_t i = 0; i < g.triangles.size(); ++i)
+    if (!zero_area(g, i)) ids.push_back(static_cast<std::uint32_t>(i));
+  for (std::size_t i = 0; i < g.spheres.size(); ++i) ids.push_back(static_cast<std::uint32_t>(g.triangles.size() + i));
+  return ids;
+}
+
+}  // namespace rtcl

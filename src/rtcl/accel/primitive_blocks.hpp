@@ -1,0 +1,37 @@
+// Primitive data in leaf order: blocks of up to eight triangles or eight
+// spheres in SoA form (kernels/shared/layouts.h), shared by every structure.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "rtcl/cl/device.hpp"
+#include "rtcl/layouts.hpp"
+#include "rtcl/scene/geometry.hpp"
+
+namespace rtcl {
+
+struct PrimitiveBlocks {
+  std::vector<TriangleBlock> triangles;
+  std::vector<SphereBlock> spheres;
+
+  // Appends one block holding `prims` (1..8 ids, all triangles or all spheres
+  // of `geometry`) and returns its leaf child reference (RTCL_LEAF_*).
+  rtcl_i32 append(const Geometry& geometry, std::span<const std::uint32_t> prims);
+  std::size_t bytes() const;
+};
+
+// The blocks on the device. A kind with no block gets a one-block placeholder
+// buffer so that kernel signatures never change.
+struct DevicePrimitives {
+  cl::Buffer triangles, spheres;
+  std::size_t bytes = 0;
+};
+DevicePrimitives upload(const Device& device, const PrimitiveBlocks& blocks);
+
+// Ids of the primitives a structure stores: every sphere and every triangle
+// whose area is not zero.
+std::vector<std::uint32_t> stored_primitives(const Geometry& geometry);
+
+}  // namespace rtcl

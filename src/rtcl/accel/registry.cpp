@@ -1,0 +1,38 @@
+// The one list of structures make_accel knows. A new structure adds its
+// builder file, its kernel file and one line here.
+#include <functional>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel/brute.hpp"
+#include "rtcl/error.hpp"
+
+namespace rtcl {
+
+namespace {
+
+using Factory = std::function<std::unique_ptr<Accel>(const Device&, const Geometry&)>;
+
+const std::vector<std::pair<std::string, Factory>>& registry() {
+  static const std::vector<std::pair<std::string, Factory>> entries = {
+      {"brute", make_brute},
+  };
+  return entries;
+}
+
+}  // namespace
+
+std::vector<std::string> accel_names() {
+  std::vector<std::string> names;
+  for (const auto& entry : registry()) names.push_back(entry.first);
+  return names;
+}
+
+std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry) {
+  for (const auto& entry : registry())
+    if (entry.first == name) return entry.second(device, geometry);
+  std::string known;
+  for (const auto& entry : registry()) known += (known.empty() ? "" : ", ") + entry.first;
+  throw Error("--accel " + std::string(name) + ": unknown acceleration structure (known: " + known + ")");
+}
+
+}  // namespace rtcl

@@ -1,0 +1,67 @@
+// The OpenCL device layer: discovery, selection, adoption of a caller's
+// context and queue, and the per-device program cache.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rtcl/cl/opencl.hpp"
+
+namespace rtcl {
+
+struct DeviceInfo {
+  std::size_t index = 0;  // position in list_devices(): what --device N selects
+  std::string platform;
+  std::string name;
+  std::string type;     // "cpu", "gpu", "accelerator", "other"
+  std::string version;  // CL_DEVICE_VERSION
+  unsigned compute_units = 0;
+  std::size_t global_mem_bytes = 0;
+  std::size_t max_alloc_bytes = 0;  // CL_DEVICE_MAX_MEM_ALLOC_SIZE: largest buffer
+  bool fp64 = false;
+};
+
+// Every device of every platform, in platform then device order. Empty when
+// no OpenCL platform is installed.
+std::vector<DeviceInfo> list_devices();
+
+class Device {
+ public:
+  // selector: "" uses $RTCL_DEVICE when set, else device 0; a number selects
+  // by list_devices() index; anything else is a case-insensitive substring of
+  // "platform name device name". Throws Error naming the selector when
+  // nothing matches or no device exists.
+  static Device open(std::string_view selector = {});
+
+  // Uses a context, device and queue the caller already has (retained, not
+  // owned). The queue may be in-order or out-of-order; rtcl orders its own
+  // commands with events.
+  static Device adopt(cl_context context, cl_device_id device, cl_command_queue queue);
+
+  const DeviceInfo& info() const;
+  const cl::Context& context() const;
+  const cl::Device& device() const;
+  cl::CommandQueue& queue() const;
+  bool profiling() const;  // the queue records event times
+
+  // The program built from an embedded kernel file (path under kernels/,
+  // e.g. "accel/bvh.cl") with -D defines ("NAME" or "NAME=VALUE"). Cached per
+  // device + source hash + options; a build failure throws Error with the log.
+  cl::Program program(const std::string& kernel_file, const std::vector<std::string>& defines) const;
+
+  // A device buffer holding a copy of host data; Error names `what` when it
+  // exceeds the device's largest allocation.
+  cl::Buffer upload(const void* data, std::size_t bytes, const char* what) const;
+  cl::Buffer allocate(std::size_t bytes, const char* what, cl_mem_flags flags = CL_MEM_READ_WRITE) const;
+
+  struct State;
+
+ private:
+  explicit Device(std::shared_ptr<State> state);
+  std::shared_ptr<State> state_;
+};
+
+}  // namespace rtcl

@@ -1,0 +1,20 @@
+// Errors a user can act on: every message names the input and what is wrong.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace rtcl {
+
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Throws Error("CALL failed: CL_NAME (code)") unless status is CL_SUCCESS.
+void check_cl(int status, const char* call);
+
+// "CL_OUT_OF_RESOURCES" for -5; "unknown OpenCL error" otherwise.
+const char* cl_error_name(int status);
+
+}  // namespace rtcl

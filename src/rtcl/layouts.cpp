@@ -1,0 +1,19 @@
+// Compile-time proof that the host sees the layouts the kernels use; the
+// device side is proved at run time by kernels/probe/layout_probe.cl.
+#include "rtcl/layouts.hpp"
+
+#include <cstddef>
+
+namespace rtcl {
+
+static_assert(sizeof(Ray) == 32 && alignof(Ray) == 4);
+static_assert(offsetof(Ray, ox) == 0 && offsetof(Ray, dx) == 12 && offsetof(Ray, tmin) == 24 &&
+              offsetof(Ray, tmax) == 28);
+static_assert(sizeof(Hit) == 16 && alignof(Hit) == 4);
+static_assert(offsetof(Hit, t) == 0 && offsetof(Hit, u) == 4 && offsetof(Hit, v) == 8 && offsetof(Hit, prim) == 12);
+static_assert(sizeof(TriangleBlock) == 320 && offsetof(TriangleBlock, prim) == 288);
+static_assert(sizeof(SphereBlock) == 160 && offsetof(SphereBlock, r) == 96 && offsetof(SphereBlock, prim) == 128);
+static_assert(sizeof(Bvh8Node) == 224 && offsetof(Bvh8Node, child) == 192);
+static_assert(sizeof(Bvh8Node) % 32 == 0, "nodes must start on float8 boundaries");
+
+}  // namespace rtcl

@@ -1,0 +1,51 @@
+// What the acceleration structures are built over: triangles (indexed) and
+// analytic spheres. Primitive ids: triangles 0 .. triangle_count-1 in array
+// order, then spheres.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rtcl/bounds/aabb.hpp"
+
+namespace rtcl {
+
+struct Sphere {
+  glm::vec3 center{0.0f};
+  float radius = 1.0f;
+};
+
+struct Geometry {
+  std::vector<glm::vec3> vertices;
+  std::vector<glm::uvec3> triangles;  // indices into vertices
+  std::vector<Sphere> spheres;
+  std::string source = "geometry";  // named in error messages (a file path, "scene", ...)
+
+  // Copies caller arrays: xyz = 3 floats per vertex, indices = 3 per triangle.
+  static Geometry from_arrays(const float* xyz, std::size_t vertex_count, const std::uint32_t* indices,
+                              std::size_t triangle_count, std::string source = "geometry");
+
+  std::size_t primitive_count() const { return triangles.size() + spheres.size(); }
+  Aabb primitive_bounds(std::size_t prim) const;
+  Aabb bounds() const;
+};
+
+struct GeometryReport {
+  std::size_t zero_area_triangles = 0;  // skipped by every structure; ids keep file order
+};
+
+// Throws Error naming geometry.source and the first offending element for:
+// NaN/Inf vertex coordinates, out-of-range indices, NaN/Inf or non-positive
+// sphere radius or centre, and a scene with nothing to hit (no primitive, or
+// only zero-area triangles). Counts zero-area triangles (exactly zero in
+// double precision).
+GeometryReport validate(const Geometry& geometry);
+
+// True when the triangle's area is exactly zero in double precision.
+bool zero_area(const Geometry& geometry, std::size_t triangle);
+
+}  // namespace rtcl

@@ -1,0 +1,71 @@
+#include "support/fixtures.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+
+namespace rtcl::test {
+
+const Device& test_device() {
+  static const Device device = [] {
+    try {
+      return Device::open();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "FATAL: the tests need an OpenCL device: %s\n", e.what());
+      std::abort();
+    }
+  }();
+  return device;
+}
+
+std::string scene_path(const std::string& relative) { return std::string(RTCL_SCENE_DIR) + "/" + relative; }
+
+Geometry random_soup(std::size_t count, std::uint32_t seed, float size, float scale, glm::vec3 offset) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), centred(-0.5f, 0.5f);
+  Geometry g;
+  g.source = "random soup";
+  for (std::size_t i = 0; i < count; ++i) {
+    glm::vec3 c(unit(rng), unit(rng), unit(rng));
+    for (int k = 0; k < 3; ++k) {
+      glm::vec3 v = c + size * glm::vec3(centred(rng), centred(rng), centred(rng));
+      g.vertices.push_back(v * scale + offset);
+    }
+    auto base = static_cast<std::uint32_t>(3 * i);
+    g.triangles.push_back({base, base + 1, base + 2});
+  }
+  return g;
+}
+
+std::vector<Ray> random_rays(const Geometry& geometry, std::size_t count, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  Aabb box = geometry.bounds();
+  glm::vec3 c = box.center();
+  float radius = glm::length(box.extent());
+  std::vector<Ray> rays;
+  for (std::size_t i = 0; i < count; ++i) {
+    glm::vec3 dir_out = glm::normalize(glm::vec3(normal(rng), normal(rng), normal(rng)));
+    glm::vec3 o = c + radius * dir_out;
+    glm::vec3 target = box.lower + box.extent() * glm::vec3(unit(rng), unit(rng), unit(rng));
+    glm::vec3 d = target - o;
+    rays.push_back({o.x, o.y, o.z, d.x, d.y, d.z, 0.0f, std::numeric_limits<float>::infinity()});
+  }
+  return rays;
+}
+
+std::vector<Hit> run_query(const Accel& accel, const std::vector<Ray>& rays, Query query) {
+  const Device& device = accel.device();
+  cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), "test rays");
+  cl::Buffer hit_buffer = device.allocate(rays.size() * sizeof(Hit), "test hits");
+  std::vector<Hit> hits(rays.size());
+  with_cl_errors([&] {
+    cl::Event done = accel.trace(query, ray_buffer, hit_buffer, rays.size());
+    std::vector<cl::Event> wait{done};
+    device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data(), &wait);
+  });
+  return hits;
+}
+
+}  // namespace rtcl::test

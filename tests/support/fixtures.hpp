@@ -1,0 +1,34 @@
+// Shared test inputs: the device under test, scenes, ray sets, and a helper
+// that runs a query on the device and reads the hits back.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/cl/device.hpp"
+#include "rtcl/layouts.hpp"
+#include "rtcl/scene/geometry.hpp"
+
+namespace rtcl::test {
+
+// The device every test uses: $RTCL_DEVICE or the first one. A missing device
+// is a failure (std::abort with a message), never a skip.
+const Device& test_device();
+
+// Absolute path of a file under ../shared/scenes.
+std::string scene_path(const std::string& relative);
+
+// `count` random triangles of size ~`size` inside [0, 1]^3 * scale + offset.
+Geometry random_soup(std::size_t count, std::uint32_t seed, float size = 0.05f, float scale = 1.0f,
+                     glm::vec3 offset = glm::vec3(0.0f));
+
+// Rays from random points on a sphere around the geometry towards random
+// points inside its bounds.
+std::vector<Ray> random_rays(const Geometry& geometry, std::size_t count, std::uint32_t seed);
+
+// Uploads rays, runs the query, returns the hits.
+std::vector<Hit> run_query(const Accel& accel, const std::vector<Ray>& rays, Query query);
+
+}  // namespace rtcl::test

@@ -1,0 +1,151 @@
+#include "support/reference.hpp"
+
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <glm/glm.hpp>
+
+namespace rtcl::test {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+glm::dvec3 origin(const Ray& r) { return {r.ox, r.oy, r.oz}; }
+glm::dvec3 direction(const Ray& r) { return {r.dx, r.dy, r.dz}; }
+
+double distance_to_segment(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b) {
+  glm::dvec3 ab = b - a;
+  double len2 = glm::dot(ab, ab);
+  double s = len2 > 0 ? glm::clamp(glm::dot(p - a, ab) / len2, 0.0, 1.0) : 0.0;
+  return glm::length(p - (a + s * ab));
+}
+
+}  // namespace
+
+PrimHit reference_intersect(const Geometry& g, std::uint32_t prim, const Ray& ray) {
+  PrimHit out;
+  glm::dvec3 o = origin(ray), d = direction(ray);
+  if (prim < g.triangles.size()) {
+    const glm::uvec3& tri = g.triangles[prim];
+    glm::dvec3 a(g.vertices[tri.x]), b(g.vertices[tri.y]), c(g.vertices[tri.z]);
+    glm::dvec3 n = glm::cross(b - a, c - a);
+    double denom = glm::dot(n, d);
+    if (denom == 0.0 || glm::dot(n, n) == 0.0) return out;
+    out.plane = true;
+    out.t = glm::dot(n, a - o) / denom;
+    glm::dvec3 p = o + out.t * d;
+    // inside test by edge signs; margin = distance to the nearest edge
+    double s0 = glm::dot(glm::cross(b - a, p - a), n), s1 = glm::dot(glm::cross(c - b, p - b), n),
+           s2 = glm::dot(glm::cross(a - c, p - c), n);
+    double dist = std::min({distance_to_segment(p, a, b), distance_to_segment(p, b, c), distance_to_segment(p, c, a)});
+    bool inside = s0 >= 0 && s1 >= 0 && s2 >= 0;
+    out.margin = inside ? dist : -dist;
+    return out;
+  }
+  const Sphere& s = g.spheres[prim - g.triangles.size()];
+  glm::dvec3 cc(s.center);
+  double a = glm::dot(d, d);
+  double tc = glm::dot(cc - o, d) / a;
+  glm::dvec3 closest = o + tc * d;
+  double dist = glm::length(closest - cc);
+  double r = s.radius;
+  out.margin = r - dist;
+  out.plane = true;
+  double half = dist < r ? std::sqrt(r * r - dist * dist) / std::sqrt(a) : 0.0;
+  double t0 = tc - half, t1 = tc + half;
+  Tolerance tol = tolerance_for(g, ray);
+  out.t = t0 >= ray.tmin - tol.t ? t0 : t1;
+  return out;
+}
+
+Tolerance tolerance_for(const Geometry& g, const Ray& ray, double ulps) {
+  Aabb box = g.bounds();
+  glm::dvec3 lo(box.lower), hi(box.upper), o = origin(ray);
+  double magnitude = std::max({glm::length(hi - lo), glm::length(lo), glm::length(hi), glm::length(o)});
+  double space = ulps * FLT_EPSILON * magnitude;
+  return {space, space / glm::length(direction(ray))};
+}
+
+Hit reference_closest(const Geometry& g, const Ray& ray) {
+  Hit best{std::numeric_limits<float>::infinity(), 0.0f, 0.0f, -1};
+  double best_t = kInf;
+  Tolerance tol = tolerance_for(g, ray);
+  for (std::uint32_t p = 0; p < g.primitive_count(); ++p) {
+    if (p < g.triangles.size() && zero_area(g, p)) continue;
+    PrimHit h = reference_intersect(g, p, ray);
+    if (!h.plane || h.margin <= tol.space) continue;
+    if (h.t < ray.tmin + tol.t || h.t > ray.tmax - tol.t) continue;
+    if (h.t < best_t) {
+      best_t = h.t;
+      best.t = static_cast<float>(h.t);
+      best.prim = static_cast<int>(p);
+    }
+  }
+  return best;
+}
+
+std::string judge(const Geometry& g, const Ray& ray, const Hit& device, Query query) {
+  Tolerance tol = tolerance_for(g, ray);
+  std::ostringstream why;
+  double device_t = device.prim >= 0 ? static_cast<double>(device.t) : kInf;
+  if (device.prim >= 0) {
+    if (device.prim >= static_cast<int>(g.primitive_count())) {
+      why << "device prim " << device.prim << " out of range";
+      return why.str();
+    }
+    PrimHit h = reference_intersect(g, static_cast<std::uint32_t>(device.prim), ray);
+    if (!h.plane || h.margin < -tol.space || std::abs(h.t - device_t) > tol.t) {
+      why << "device hit prim " << device.prim << " at t=" << device.t << " but the reference has plane=" << h.plane
+          << " t=" << h.t << " margin=" << h.margin << " (tolerance " << tol.space << ")";
+      return why.str();
+    }
+    if (device_t < ray.tmin - tol.t || device_t > ray.tmax + tol.t) {
+      why << "device t=" << device.t << " outside [" << ray.tmin << ", " << ray.tmax << "]";
+      return why.str();
+    }
+  } else if (!std::isinf(device.t) || device.prim != -1) {
+    why << "miss must be t=inf prim=-1, got t=" << device.t << " prim=" << device.prim;
+    return why.str();
+  }
+  Hit ref = reference_closest(g, ray);
+  if (ref.prim < 0) return "";
+  if (query == Query::any) {
+    if (device.prim < 0) {
+      why << "device found no hit; reference hits prim " << ref.prim << " at t=" << ref.t;
+      return why.str();
+    }
+    return "";
+  }
+  if (device_t > static_cast<double>(ref.t) + tol.t) {
+    why << "device " << (device.prim < 0 ? "missed" : "hit prim " + std::to_string(device.prim) + " at t=" +
+                                                          std::to_string(device.t))
+        << "; reference hits prim " << ref.prim << " nearer, at t=" << ref.t;
+    return why.str();
+  }
+  return "";
+}
+
+std::vector<std::string> judge_all(const Geometry& g, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                                   Query query, std::size_t* failures, std::size_t report) {
+  std::vector<std::string> out;
+  *failures = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    std::string why = judge(g, rays[i], hits[i], query);
+    if (why.empty()) continue;
+    ++*failures;
+    if (out.size() < report) {
+      const Ray& r = rays[i];
+      std::ostringstream s;
+      s.precision(9);
+      s << "ray " << i << " (o=" << r.ox << "," << r.oy << "," << r.oz << " d=" << r.dx << "," << r.dy << "," << r.dz
+        << " t=[" << r.tmin << "," << r.tmax << "]): " << why;
+      out.push_back(s.str());
+    }
+  }
+  return out;
+}
+
+}  // namespace rtcl::test

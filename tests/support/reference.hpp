@@ -1,0 +1,47 @@
+// Double-precision host reference for every query, and the rule that decides
+// whether a device answer is right. Tolerances scale with the scene: a hit is
+// "clear" when the ray passes inside the primitive by more than the spatial
+// tolerance, "ambiguous" near its boundary, where either answer is accepted.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/layouts.hpp"
+#include "rtcl/scene/geometry.hpp"
+
+namespace rtcl::test {
+
+struct PrimHit {
+  bool plane = false;   // the ray meets the primitive's surface (plane / sphere) at t
+  double t = 0.0;
+  double margin = 0.0;  // world units: > 0 inside the triangle (or sphere silhouette), < 0 outside
+};
+
+// Intersection with one primitive in double precision. For spheres, the
+// nearest root with t >= tmin - tolerance is reported.
+PrimHit reference_intersect(const Geometry& geometry, std::uint32_t prim, const Ray& ray);
+
+struct Tolerance {
+  double space;  // world units
+  double t;      // ray parameter units
+};
+// Scales with the scene's extent and the ray origin's magnitude, in units of
+// float epsilon times `ulps`.
+Tolerance tolerance_for(const Geometry& geometry, const Ray& ray, double ulps = 256.0);
+
+// Nearest clear hit (t = +inf, prim = -1 when none) by brute force in double.
+Hit reference_closest(const Geometry& geometry, const Ray& ray);
+
+// "" when the device's answer is acceptable, else why not.
+std::string judge(const Geometry& geometry, const Ray& ray, const Hit& device, Query query);
+
+// Runs judge over all rays and returns up to `report` failure descriptions
+// (and the total failure count in *failures).
+std::vector<std::string> judge_all(const Geometry& geometry, const std::vector<Ray>& rays,
+                                   const std::vector<Hit>& hits, Query query, std::size_t* failures,
+                                   std::size_t report = 5);
+
+}  // namespace rtcl::test
