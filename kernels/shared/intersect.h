@@ -127,8 +127,11 @@ inline float8 rtcl_edge8(float8 a, float8 b, float8 c, float8 d) {
   float8 e = a * d - b * c;
 #ifdef RTCL_HAS_FP64
   if (any(e == 0.0f)) {
-    double8 ed = convert_double8(a) * convert_double8(d) - convert_double8(b) * convert_double8(c);
-    e = select(e, convert_float8(ed), e == 0.0f);
+    /* two double4 halves: double8 is not a native vector type on AVX2 */
+    double4 lo = convert_double4(a.lo) * convert_double4(d.lo) - convert_double4(b.lo) * convert_double4(c.lo);
+    double4 hi = convert_double4(a.hi) * convert_double4(d.hi) - convert_double4(b.hi) * convert_double4(c.hi);
+    float8 ed = (float8)(convert_float4(lo), convert_float4(hi));
+    e = select(e, ed, e == 0.0f);
   }
 #endif
   return e;
