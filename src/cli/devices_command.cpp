@@ -1,7 +1,54 @@
+// `rtcl devices`: every OpenCL platform and device, with the index that
+// --device and RTCL_DEVICE select.
+#include <cstdio>
+#include <string>
+
 #include "commands.hpp"
+#include "rtcl/cl/device.hpp"
+#include "rtcl/error.hpp"
 
 namespace rtcl::cli {
 
-void add_devices_command(CLI::App& app) { app.add_subcommand("devices", "(not yet available)"); }
+namespace {
+
+std::string human_bytes(std::size_t bytes) {
+  const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB"};
+  double value = static_cast<double>(bytes);
+  int unit = 0;
+  while (value >= 1024.0 && unit < 4) {
+    value /= 1024.0;
+    ++unit;
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, unit == 0 ? "%.0f %s" : "%.1f %s", value, units[unit]);
+  return text;
+}
+
+void list() {
+  std::vector<DeviceInfo> devices = list_devices();
+  if (devices.empty())
+    throw Error(
+        "no OpenCL device found: install an OpenCL driver (on Debian: apt-get install pocl-opencl-icd; "
+        "ocl-icd reads drivers from /etc/OpenCL/vendors or $OCL_ICD_VENDORS)");
+  std::string platform;
+  for (const DeviceInfo& d : devices) {
+    if (d.platform != platform) {
+      platform = d.platform;
+      std::printf("platform: %s\n", platform.c_str());
+    }
+    std::printf("  [%zu] %s (%s)\n", d.index, d.name.c_str(), d.type.c_str());
+    std::printf("      version: %s\n", d.version.c_str());
+    std::printf("      compute units: %u, global memory: %s, max allocation: %s, fp64: %s\n", d.compute_units,
+                human_bytes(d.global_mem_bytes).c_str(), human_bytes(d.max_alloc_bytes).c_str(), d.fp64 ? "yes" : "no");
+  }
+}
+
+}  // namespace
+
+void add_devices_command(CLI::App& app) {
+  CLI::App* cmd = app.add_subcommand(
+      "devices", "List OpenCL platforms and devices; the index in [N] is what --device N and RTCL_DEVICE=N select");
+  cmd->callback(list);
+}
 
 }  // namespace rtcl::cli

@@ -57,8 +57,11 @@ DeviceInfo describe(const cl::Platform& platform, const cl::Device& device, std:
 std::vector<std::pair<cl::Platform, cl::Device>> all_devices() {
   std::vector<std::pair<cl::Platform, cl::Device>> out;
   std::vector<cl::Platform> platforms;
-  cl_int status = cl::Platform::get(&platforms);
-  if (status != CL_SUCCESS) return out;  // ocl-icd: no platform installed
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error&) {
+    return out;  // ocl-icd: no platform installed (CL_PLATFORM_NOT_FOUND_KHR)
+  }
   for (auto& p : platforms) {
     std::vector<cl::Device> devices;
     try {

@@ -1,0 +1,230 @@
+// Runs the built `rtcl` binary as a subprocess, with good and bad inputs in a
+// temporary directory, and checks exit codes, messages and output files.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "rtcl/io/ray_file.hpp"
+#include "rtcl/scene/mesh_io.hpp"
+#include "support/fixtures.hpp"
+#include "support/reference.hpp"
+#include "support/temp_dir.hpp"
+
+namespace rtcl::test {
+namespace {
+
+struct CliRun {
+  int status = -1;  // exit code; -1 when the process did not exit normally (a crash), -2: no binary
+  std::string out, err;
+};
+
+std::string shell_quoted(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// `env` is prepended as shell assignments ("NAME=value ...", already quoted).
+CliRun run_cli(const TempDir& dir, const std::vector<std::string>& args, const std::string& env = "") {
+  if (!std::filesystem::exists(std::string(RTCL_BINARY_DIR) + "/rtcl"))
+    return {-2, "",
+            std::string("the rtcl binary is missing from ") + RTCL_BINARY_DIR + " (configure with RTCL_BUILD_CLI=ON)"};
+  std::string command =
+      "cd " + shell_quoted(dir.path()) + " && " + env + " " + shell_quoted(std::string(RTCL_BINARY_DIR) + "/rtcl");
+  for (const auto& a : args) command += " " + shell_quoted(a);
+  std::string out = dir.file(".stdout"), err = dir.file(".stderr");
+  command += " >" + shell_quoted(out) + " 2>" + shell_quoted(err);
+  int raw = std::system(command.c_str());
+  CliRun run;
+  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  run.out = read_text(out);
+  run.err = read_text(err);
+  std::remove(out.c_str());
+  std::remove(err.c_str());
+  return run;
+}
+
+std::size_t count_of(const std::string& text, const std::string& fragment) {
+  std::size_t n = 0;
+  for (std::size_t p = text.find(fragment); p != std::string::npos; p = text.find(fragment, p + 1)) ++n;
+  return n;
+}
+
+// A failed run: exit 1, exactly one "rtcl: error:" line containing
+// `fragment`, and no hit file left behind (`hits` when given).
+void expect_failure(const CliRun& run, const std::string& fragment, const TempDir& dir, const std::string& hits = "") {
+  EXPECT_EQ(run.status, 1) << run.err;
+  EXPECT_EQ(count_of(run.err, "rtcl: error:"), 1u) << run.err;
+  EXPECT_NE(run.err.find(fragment), std::string::npos) << run.err;
+  if (!hits.empty()) EXPECT_FALSE(std::filesystem::exists(dir.file(hits))) << hits << " was written";
+  for (const auto& name : dir.entries()) EXPECT_EQ(name.find(".tmp-"), std::string::npos) << "left behind: " << name;
+}
+
+// Two triangles forming a unit quad at z = 0 plus a tetrahedron above it.
+const char* const small_obj =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.2 0.2 0.5\nv 0.8 0.2 0.5\nv 0.5 0.8 0.5\nv 0.5 0.4 0.9\n"
+    "o floor\nf 1 2 3 4\no tetra\nf 5 6 7\nf 5 6 8\nf 6 7 8\nf 7 5 8\n";
+
+struct Inputs {
+  TempDir dir;
+  std::string mesh, rays;
+  std::vector<Ray> ray_list;
+  Inputs() {
+    mesh = dir.write("scene.obj", small_obj);
+    Geometry g = load_mesh(mesh).geometry;
+    ray_list = random_rays(g, 400, 7);
+    rays = dir.file("scene.rays");
+    write_rays(rays, ray_list);
+  }
+};
+
+TEST(Cli, NoArgumentsShowsUsageAndFails) {
+  TempDir dir;
+  CliRun run = run_cli(dir, {});
+  EXPECT_NE(run.status, 0);
+  EXPECT_NE(run.err.find("Usage: rtcl"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("trace"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("devices"), std::string::npos) << run.err;
+}
+
+TEST(Cli, TraceWithoutOutputIsAUsageError) {
+  Inputs in;
+  CliRun run = run_cli(in.dir, {"trace", in.mesh, in.rays});
+  EXPECT_NE(run.status, 0);
+  EXPECT_NE(run.err.find("--output"), std::string::npos) << run.err;
+}
+
+TEST(Cli, DevicesListsTheTestDevice) {
+  TempDir dir;
+  CliRun run = run_cli(dir, {"devices"});
+  EXPECT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("[0] "), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(test_device().info().name), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("max allocation"), std::string::npos) << run.out;
+}
+
+TEST(Cli, NoOpenClDeviceIsAClearError) {
+  Inputs in;
+  TempDir no_vendors;
+  std::string env = "OCL_ICD_VENDORS=" + shell_quoted(no_vendors.path());
+  expect_failure(run_cli(in.dir, {"devices"}, env), "no OpenCL device found", in.dir);
+  expect_failure(run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits"}, env), "no OpenCL device found", in.dir,
+                 "out.hits");
+}
+
+TEST(Cli, TraceMatchesTheReference) {
+  Inputs in;
+  Geometry g = load_mesh(in.mesh).geometry;
+  for (const std::string accel : {"", "brute"}) {
+    for (bool any : {false, true}) {
+      std::vector<std::string> args = {"trace", in.mesh, in.rays, "-o", "out.hits"};
+      if (!accel.empty()) args.insert(args.end(), {"--accel", accel});
+      if (any) args.push_back("--any");
+      CliRun run = run_cli(in.dir, args);
+      ASSERT_EQ(run.status, 0) << run.err;
+      EXPECT_EQ(run.err, "");
+      EXPECT_NE(run.out.find(test_device().info().name), std::string::npos) << run.out;
+      EXPECT_NE(run.out.find("Mrays/s"), std::string::npos) << run.out;
+      EXPECT_NE(run.out.find("built in"), std::string::npos) << run.out;
+      std::vector<Hit> hits = read_hits(in.dir.file("out.hits"));
+      ASSERT_EQ(hits.size(), in.ray_list.size());
+      std::size_t failures = 0, hit_count = 0;
+      auto report = judge_all(g, in.ray_list, hits, any ? Query::any : Query::closest, &failures);
+      EXPECT_EQ(failures, 0u) << (report.empty() ? "" : report[0]) << " (accel '" << accel << "', any " << any << ")";
+      for (const Hit& h : hits) hit_count += h.prim >= 0;
+      EXPECT_GT(hit_count, in.ray_list.size() / 4) << "the rays aim at the mesh";
+    }
+  }
+}
+
+TEST(Cli, EmptyRayFileWritesAnEmptyHitFile) {
+  Inputs in;
+  in.dir.write("none.rays", "");
+  CliRun run = run_cli(in.dir, {"trace", in.mesh, "none.rays", "-o", "none.hits"});
+  EXPECT_EQ(run.status, 0) << run.err;
+  EXPECT_TRUE(std::filesystem::exists(in.dir.file("none.hits")));
+  EXPECT_EQ(read_text(in.dir.file("none.hits")), "");
+}
+
+TEST(Cli, ZeroAreaTrianglesAreSkippedAndSaidOnce) {
+  Inputs in;
+  in.dir.write("flat.obj", std::string(small_obj) + "f 1 2 2\nf 3 3 3\n");
+  CliRun run = run_cli(in.dir, {"trace", "flat.obj", in.rays, "-o", "out.hits"});
+  EXPECT_EQ(run.status, 0) << run.err;
+  EXPECT_EQ(count_of(run.err, "2 zero-area triangles skipped"), 1u) << run.err;
+  EXPECT_EQ(read_hits(in.dir.file("out.hits")).size(), in.ray_list.size());
+}
+
+TEST(CliErrors, BadMeshes) {
+  Inputs in;
+  auto trace = [&](const std::string& mesh) { return run_cli(in.dir, {"trace", mesh, in.rays, "-o", "out.hits"}); };
+  expect_failure(trace("absent.obj"), "absent.obj: no such mesh file", in.dir, "out.hits");
+  in.dir.write("malformed.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n");
+  expect_failure(trace("malformed.obj"), "malformed.obj: cannot import mesh: OBJ: Invalid face index", in.dir,
+                 "out.hits");
+  in.dir.write("nan.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n");
+  expect_failure(trace("nan.obj"), "nan.obj: triangle 0 (object 'defaultobject') has a NaN or infinite vertex", in.dir,
+                 "out.hits");
+  in.dir.write("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+  expect_failure(trace("range.obj"), "range.obj: cannot import mesh: OBJ: vertex index out of range", in.dir,
+                 "out.hits");
+  in.dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
+  expect_failure(trace("flat.obj"), "flat.obj: empty scene", in.dir, "out.hits");
+  in.dir.write("mesh.fbx", "x");
+  expect_failure(trace("mesh.fbx"), "unsupported mesh format '.fbx'", in.dir, "out.hits");
+}
+
+TEST(CliErrors, BadRayFiles) {
+  Inputs in;
+  auto trace = [&](const std::string& rays) { return run_cli(in.dir, {"trace", in.mesh, rays, "-o", "out.hits"}); };
+  in.dir.write("odd.rays", std::string(33, '\0'));
+  expect_failure(trace("odd.rays"), "odd.rays: size 33 bytes is not a multiple of 32", in.dir, "out.hits");
+  std::vector<Ray> rays(in.ray_list.begin(), in.ray_list.begin() + 10);
+  rays[4].dy = std::numeric_limits<float>::quiet_NaN();
+  write_rays(in.dir.file("nan.rays"), rays);
+  expect_failure(trace("nan.rays"), "nan.rays: 1 of 10 rays are invalid; the first is ray 4", in.dir, "out.hits");
+  rays[4] = in.ray_list[4];
+  rays[7].dx = rays[7].dy = rays[7].dz = 0.0f;
+  write_rays(in.dir.file("zero.rays"), rays);
+  expect_failure(trace("zero.rays"), "ray 7 (byte offset 224): its direction has zero length", in.dir, "out.hits");
+  expect_failure(trace("absent.rays"), "absent.rays: no such ray file", in.dir, "out.hits");
+}
+
+TEST(CliErrors, UnknownAccelAndDevice) {
+  Inputs in;
+  std::vector<std::string> base = {"trace", in.mesh, in.rays, "-o", "out.hits"};
+  auto with = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = base;
+    args.insert(args.end(), extra.begin(), extra.end());
+    return run_cli(in.dir, args);
+  };
+  expect_failure(with({"--accel", "octopus"}), "--accel octopus: unknown acceleration structure (known: brute", in.dir,
+                 "out.hits");
+  expect_failure(with({"--device", "no-such-device-name"}), "--device 'no-such-device-name': no device name matches",
+                 in.dir, "out.hits");
+  expect_failure(with({"--device", "99"}), "--device 99: no such device", in.dir, "out.hits");
+}
+
+TEST(CliErrors, UnwritableOutputLeavesNothing) {
+  Inputs in;
+  CliRun run = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "missing/dir/out.hits"});
+  expect_failure(run, "missing/dir/out.hits: cannot write: directory 'missing/dir' does not exist", in.dir);
+  std::filesystem::create_directory(in.dir.file("taken"));
+  expect_failure(run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "taken"}), "taken: cannot write: it is a directory",
+                 in.dir);
+}
+
+TEST(CliErrors, FailureKeepsAnOldHitFile) {
+  Inputs in;
+  in.dir.write("out.hits", "previous");
+  expect_failure(run_cli(in.dir, {"trace", "absent.obj", in.rays, "-o", "out.hits"}), "no such mesh file", in.dir);
+  EXPECT_EQ(read_text(in.dir.file("out.hits")), "previous");
+}
+
+}  // namespace
+}  // namespace rtcl::test
