@@ -13,11 +13,14 @@
  * contraction into fma. */
 #pragma OPENCL FP_CONTRACT OFF
 
-/* |d| below this is clamped (sign kept) before taking 1/d, so the slab test
- * never forms 0 * inf = NaN: a ±0 direction component gives a finite 1e18
- * reciprocal whose slab is conservative (it may admit a box the ray misses by
- * less than 1e-18 of its length, never rejects one it touches). */
-#define RTCL_MIN_DIR_COMPONENT 1e-18f
+/* Slab test and ±0 direction components: the reciprocal of ±0 is ±inf, so a
+ * ray parallel to an axis gets slab distances (b - o) * inf = ±inf, exact for
+ * an origin strictly inside or outside the slab. An origin exactly on one of
+ * the slab's planes gives 0 * inf = NaN, and fmin/fmax drop a NaN operand
+ * (OpenCL C 1.2, 6.12.2): that plane then does not limit the interval, which
+ * is exact too, since the ray stays on the closed slab for every t. Clamping
+ * |d| to a tiny finite value instead would reject a box whose face the ray
+ * lies on (tf = 0 * 1/eps = 0) for one sign of zero but not the other. */
 /* Relative widening of each slab interval: covers the rounding of (b - o),
  * of the reciprocal (<= 2.5 ulp in OpenCL C) and of the product, with margin
  * (Ize 2013, "Robust BVH ray traversal"). */
@@ -26,7 +29,7 @@
 /* Per-ray constants for traversal, computed once per ray. */
 typedef struct TraceRay {
   float ox, oy, oz, tmin, tmax;
-  float ix, iy, iz;          /* clamped reciprocal direction (slab test) */
+  float ix, iy, iz;          /* reciprocal direction, ±inf for ±0 (slab test) */
   int near_x, near_y, near_z; /* bounds row holding each axis's entry plane */
   int far_x, far_y, far_z;    /* ... and its exit plane */
   /* watertight triangle test (Woop, Benthin, Wald 2013, JCGT 2(1)) */
@@ -35,10 +38,6 @@ typedef struct TraceRay {
   float okx, oky, okz;        /* origin, permuted */
   float dx, dy, dz;
 } TraceRay;
-
-inline float rtcl_clamped_reciprocal(float d) {
-  return 1.0f / (fabs(d) < RTCL_MIN_DIR_COMPONENT ? copysign(RTCL_MIN_DIR_COMPONENT, d) : d);
-}
 
 /* Returns 0 for a ray that cannot be traced (NaN anywhere, zero direction,
  * tmin > tmax): such a ray reports a miss. */
@@ -55,9 +54,9 @@ inline int trace_ray_setup(const Ray r, TraceRay* s) {
   s->ox = r.ox; s->oy = r.oy; s->oz = r.oz;
   s->dx = r.dx; s->dy = r.dy; s->dz = r.dz;
   s->tmin = r.tmin; s->tmax = r.tmax;
-  s->ix = rtcl_clamped_reciprocal(r.dx);
-  s->iy = rtcl_clamped_reciprocal(r.dy);
-  s->iz = rtcl_clamped_reciprocal(r.dz);
+  s->ix = 1.0f / r.dx;
+  s->iy = 1.0f / r.dy;
+  s->iz = 1.0f / r.dz;
   s->near_x = s->ix >= 0.0f ? 0 : 3;
   s->near_y = s->iy >= 0.0f ? 1 : 4;
   s->near_z = s->iz >= 0.0f ? 2 : 5;
@@ -74,7 +73,9 @@ inline int trace_ray_setup(const Ray r, TraceRay* s) {
 
 /* Slab test of the ray against the node's eight child boxes over
  * [tmin, tmax]. Returns the hit mask (lane = -1 where hit) and the entry
- * distances. Empty slots (lower = +inf, upper = -inf) never hit. */
+ * distances. Empty slots (lower = +inf, upper = -inf) never hit. The NaN of
+ * an origin on the plane of a parallel slab is dropped by fmax/fmin (see
+ * above); tmin and tmax are never NaN, so tn and tf are not either. */
 inline int8 intersect_boxes8(global const Bvh8Node* node, const TraceRay* s, float tmax, float8* t_entry) {
   global const float8* b = (global const float8*)node->bounds;
   float8 tnx = (b[s->near_x] - s->ox) * s->ix;

@@ -42,10 +42,24 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
       device_.queue().enqueueMarkerWithWaitList(&wait, &done);
       return done;
     }
-    device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(ray_count), cl::NullRange,
+    // A fixed work-group size (global rounded up; the kernels check ray_count):
+    // PoCL generates code per local size, and left to choose (NULL) it picks
+    // one per global size, so each new ray count would cost a code generation.
+    const std::size_t group = 64;
+    bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device()) >= group;
+    std::size_t global = fixed ? (ray_count + group - 1) / group * group : ray_count;
+    device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
+                                         fixed ? cl::NDRange(group) : cl::NullRange,
                                          wait.empty() ? nullptr : &wait, &done);
     return done;
   });
+}
+
+cl::Event Accel::trace(Query query, cl_mem rays, cl_mem hits, std::size_t ray_count,
+                       const std::vector<cl::Event>& wait) const {
+  if (!rays || !hits) throw Error(name_ + " trace: null ray or hit buffer");
+  return with_cl_errors(
+      [&] { return trace(query, cl::Buffer(rays, true), cl::Buffer(hits, true), ray_count, wait); });
 }
 
 std::vector<std::string> primitive_defines(const Geometry& geometry) {

@@ -43,6 +43,10 @@ class Accel {
   // when a buffer is smaller than ray_count records. Not thread-safe per Accel.
   cl::Event trace(Query query, const cl::Buffer& rays, const cl::Buffer& hits, std::size_t ray_count,
                   const std::vector<cl::Event>& wait = {}) const;
+  // The same on a caller's raw buffers (retained for the call, not owned):
+  // for applications on the OpenCL C API.
+  cl::Event trace(Query query, cl_mem rays, cl_mem hits, std::size_t ray_count,
+                  const std::vector<cl::Event>& wait = {}) const;
 
  protected:
   Accel(const Device& device, std::string name, const std::string& kernel_file, std::vector<std::string> defines,

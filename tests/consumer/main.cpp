@@ -1,0 +1,120 @@
+// An application that already owns its OpenCL objects (made with the C API)
+// and uses rtcl as its ray-tracing backend: it adopts its context and queue,
+// builds a structure over its own arrays, and traces rays from its own cl_mem
+// buffers into its own cl_mem buffers. Exits 0 when the answers are right.
+#include <rtcl/accel/accel.hpp>
+#include <rtcl/cl/device.hpp>
+#include <rtcl/error.hpp>
+#include <rtcl/layouts.hpp>
+#include <rtcl/scene/geometry.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace {
+
+int failures = 0;
+
+void expect(bool ok, const std::string& what) {
+  if (ok) return;
+  std::fprintf(stderr, "FAILED: %s\n", what.c_str());
+  ++failures;
+}
+
+void check(cl_int status, const char* call) {
+  if (status != CL_SUCCESS) throw rtcl::Error(std::string(call) + " failed with " + std::to_string(status));
+}
+
+// The first device of the first platform that has one.
+void first_device(cl_platform_id* platform, cl_device_id* device) {
+  cl_uint platform_count = 0;
+  check(clGetPlatformIDs(0, nullptr, &platform_count), "clGetPlatformIDs");
+  std::vector<cl_platform_id> platforms(platform_count);
+  check(clGetPlatformIDs(platform_count, platforms.data(), nullptr), "clGetPlatformIDs");
+  for (cl_platform_id p : platforms) {
+    if (clGetDeviceIDs(p, CL_DEVICE_TYPE_ALL, 1, device, nullptr) == CL_SUCCESS) {
+      *platform = p;
+      return;
+    }
+  }
+  throw rtcl::Error("no OpenCL device");
+}
+
+}  // namespace
+
+int main() try {
+  cl_platform_id platform = nullptr;
+  cl_device_id device = nullptr;
+  first_device(&platform, &device);
+  cl_int status = CL_SUCCESS;
+  cl_context_properties properties[] = {CL_CONTEXT_PLATFORM, reinterpret_cast<cl_context_properties>(platform), 0};
+  cl_context context = clCreateContext(properties, 1, &device, nullptr, nullptr, &status);
+  check(status, "clCreateContext");
+  cl_command_queue queue = clCreateCommandQueue(context, device, 0, &status);
+  check(status, "clCreateCommandQueue");
+
+  rtcl::Device backend = rtcl::Device::adopt(context, device, queue);
+
+  // The square [-1, 1]^2 at z = 0, as the application stores it.
+  const float xyz[] = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0};
+  const std::uint32_t indices[] = {0, 1, 2, 0, 2, 3};
+  rtcl::Geometry quad = rtcl::Geometry::from_arrays(xyz, 4, indices, 2, "consumer quad");
+  std::vector<std::string> names = rtcl::accel_names();
+  std::string name = std::find(names.begin(), names.end(), "bvh") != names.end() ? "bvh" : names.front();
+  auto accel = rtcl::make_accel(backend, name, quad);
+
+  // Ray records: origin, direction, [tmin, tmax] (32 bytes each).
+  const float inf = INFINITY;
+  const rtcl::Ray rays[3] = {
+      {0.25f, 0.5f, -2.0f, 0.0f, 0.0f, 1.0f, 0.0f, inf},  // hits triangle 1 at t = 2
+      {3.0f, 0.0f, -2.0f, 0.0f, 0.0f, 1.0f, 0.0f, inf},   // passes beside the quad
+      {0.25f, 0.5f, -2.0f, 0.0f, 0.0f, 1.0f, 0.0f, 1.5f}, // stops short of it
+  };
+  cl_mem ray_buffer = clCreateBuffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, sizeof rays,
+                                     const_cast<rtcl::Ray*>(rays), &status);
+  check(status, "clCreateBuffer");
+  cl_mem hit_buffer = clCreateBuffer(context, CL_MEM_WRITE_ONLY, 3 * sizeof(rtcl::Hit), nullptr, &status);
+  check(status, "clCreateBuffer");
+
+  for (rtcl::Query query : {rtcl::Query::closest, rtcl::Query::any}) {
+    std::string label = name + (query == rtcl::Query::closest ? " closest" : " any");
+    accel->trace(query, ray_buffer, hit_buffer, 3);
+    check(clFinish(queue), "clFinish");
+    rtcl::Hit hits[3];
+    check(clEnqueueReadBuffer(queue, hit_buffer, CL_TRUE, 0, sizeof hits, hits, 0, nullptr, nullptr),
+          "clEnqueueReadBuffer");
+    expect(hits[0].prim == 1 && hits[0].t == 2.0f, label + ": ray 0 hits triangle 1 at t = 2");
+    expect(std::abs(hits[0].u - 0.625f) < 1e-6f && std::abs(hits[0].v - 0.125f) < 1e-6f,
+           label + ": ray 0 barycentrics (0.625, 0.125)");
+    expect(hits[1].prim == -1 && std::isinf(hits[1].t), label + ": ray 1 misses");
+    expect(hits[2].prim == -1 && std::isinf(hits[2].t), label + ": ray 2 ends before the quad");
+  }
+
+  // A hit buffer one record short is refused before anything runs.
+  cl_mem short_hits = clCreateBuffer(context, CL_MEM_WRITE_ONLY, 2 * sizeof(rtcl::Hit), nullptr, &status);
+  check(status, "clCreateBuffer");
+  bool refused = false;
+  try {
+    accel->trace(rtcl::Query::closest, ray_buffer, short_hits, 3);
+  } catch (const rtcl::Error&) {
+    refused = true;
+  }
+  expect(refused, "a too small hit buffer is an rtcl::Error");
+
+  clReleaseMemObject(short_hits);
+  clReleaseMemObject(hit_buffer);
+  clReleaseMemObject(ray_buffer);
+  accel.reset();
+  clReleaseCommandQueue(queue);
+  clReleaseContext(context);
+  if (failures) return 1;
+  std::printf("rtcl consumer: %s on %s: ok\n", name.c_str(), backend.info().name.c_str());
+  return 0;
+} catch (const std::exception& e) {
+  std::fprintf(stderr, "rtcl consumer: %s\n", e.what());
+  return 1;
+}
