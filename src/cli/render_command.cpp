@@ -1,7 +1,151 @@
+// `rtcl render [scene.json] -o out.png`: Whitted ray tracing on an OpenCL
+// device. Without a scene file it renders the built-in default scene.
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <string>
+
 #include "commands.hpp"
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/cl/device.hpp"
+#include "rtcl/error.hpp"
+#include "rtcl/render/camera.hpp"
+#include "rtcl/render/image.hpp"
+#include "rtcl/render/renderer.hpp"
+#include "rtcl/scene/default_scene.hpp"
+#include "rtcl/scene/scene_file.hpp"
 
 namespace rtcl::cli {
 
-void add_render_command(CLI::App& app) { app.add_subcommand("render", "(not yet available)"); }
+namespace {
+
+struct Options {
+  std::string scene;
+  std::string output = "render.png";
+  std::string accel;
+  std::string device;
+  std::uint32_t width = 512, height = 0;  // height 0: from the camera's aspect
+  std::uint32_t depth = 5, spp = 1;
+  float min_weight = 1e-3f;
+  std::uint32_t batch = 1u << 17;
+  bool quiet = false;
+  bool verbose = false;
+};
+
+std::string default_accel() {
+  auto names = accel_names();
+  return std::find(names.begin(), names.end(), "bvh") != names.end() ? "bvh" : names.front();
+}
+
+// A one-line bar on stderr, redrawn only when the shown percentage changes.
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled) {}
+  ~ProgressBar() { finish(); }
+  void update(double fraction) {
+    if (!enabled_) return;
+    int percent = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0);
+    if (percent == shown_) return;
+    shown_ = percent;
+    const int width = 40;
+    int filled = percent * width / 100;
+    std::fprintf(stderr, "\rrendering [%s%s] %3d%%", std::string(filled, '#').c_str(),
+                 std::string(width - filled, ' ').c_str(), percent);
+    std::fflush(stderr);
+  }
+  void finish() {
+    if (enabled_ && shown_ >= 0) std::fprintf(stderr, "\r%60s\r", "");
+    shown_ = -1;
+  }
+
+ private:
+  bool enabled_;
+  int shown_ = -1;
+};
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (const auto& i : items) out += (out.empty() ? "-D" : " -D") + i;
+  return out;
+}
+
+double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? rays / (ms * 1e3) : 0.0; }
+
+void run(const Options& o) {
+  Scene scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
+  for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
+  check_image_path(o.output);  // before the long work
+
+  RenderSettings settings;
+  settings.width = o.width;
+  settings.height = o.height > 0 ? o.height : default_height(scene.camera, o.width);
+  settings.max_depth = o.depth;
+  settings.spp = o.spp;
+  settings.min_weight = o.min_weight;
+  settings.batch_pixels = o.batch;
+
+  Device device = Device::open(o.device);
+  std::string accel = o.accel.empty() ? default_accel() : o.accel;
+  Renderer renderer(device, scene, accel);
+  ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
+  Image image = renderer.render(settings, [&](double f) { bar.update(f); });
+  bar.finish();
+  write_image(o.output, image);
+
+  const RenderStats& st = renderer.stats();
+  const RayCounts& r = st.rays;
+  std::printf("rtcl render: %s (%ux%u, %u spp, depth %u, %s, %s): %llu camera + %llu shadow + %llu reflection + "
+              "%llu refraction = %llu rays in %.3f s, %.2f Mrays/s (trace only: camera %.2f, shadow %.2f, "
+              "secondary %.2f Mrays/s)\n",
+              o.output.c_str(), settings.width, settings.height, settings.spp, settings.max_depth, accel.c_str(),
+              device.info().name.c_str(), (unsigned long long)r.camera, (unsigned long long)r.shadow,
+              (unsigned long long)r.reflection, (unsigned long long)r.refraction, (unsigned long long)r.total(),
+              st.render_ms * 1e-3, mrays(r.total(), st.render_ms), mrays(r.camera, st.camera_trace_ms),
+              mrays(r.shadow, st.shadow_trace_ms), mrays(r.reflection + r.refraction, st.secondary_trace_ms));
+  if (o.verbose)
+    std::printf("rtcl render: device ms: generate %.1f, trace camera %.1f, shade %.1f, compact %.1f, trace shadow "
+                "%.1f, trace secondary %.1f, accumulate %.1f; %u generations, largest queue %zu rays, queues %.1f "
+                "MiB; kernels specialised with %s\n",
+                st.generate_ms, st.camera_trace_ms, st.shade_ms, st.compact_ms, st.shadow_trace_ms,
+                st.secondary_trace_ms, st.accumulate_ms, st.generations, st.peak_queue, st.queue_bytes / 1048576.0,
+                join(renderer.defines()).c_str());
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "render", "Whitted ray tracing (reflection, refraction, hard shadows) of a scene file, or of the built-in "
+                "default scene when none is given");
+  cmd->add_option("scene", o->scene, "Scene file (JSON, see README); none: the built-in default scene");
+  cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
+                                            ".exr: linear float)")
+      ->capture_default_str();
+  cmd->add_option("--accel", o->accel, "Acceleration structure (default: bvh)")
+      ->check(CLI::IsMember(accel_names()));
+  cmd->add_option("--device", o->device, "OpenCL device: index or name substring (see `rtcl devices`)");
+  cmd->add_option("--width", o->width, "Image width in pixels")->capture_default_str()->check(CLI::Range(1, 65536));
+  cmd->add_option("--height", o->height, "Image height in pixels (default: width / the camera's aspect)")
+      ->check(CLI::Range(1, 65536));
+  cmd->add_option("--depth", o->depth, "Reflection/refraction bounces after the first hit (speed/accuracy)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
+  cmd->add_option("--spp", o->spp, "Jittered samples per pixel (anti-aliasing)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 65536));
+  cmd->add_option("--min-weight", o->min_weight,
+                  "Drop secondary rays whose path weight is below this (speed/accuracy; 0 keeps all)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--batch", o->batch, "Camera rays per wavefront (device memory vs parallelism)")
+      ->capture_default_str()
+      ->check(CLI::Range(1u, 1u << 26));
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
+  cmd->add_flag("-v,--verbose", o->verbose, "Also print the device time of each stage and the queue sizes");
+  cmd->callback([o] { run(*o); });
+}
 
 }  // namespace rtcl::cli

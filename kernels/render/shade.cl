@@ -1,0 +1,217 @@
+/* Whitted shading as wavefront stages (lecture: IntersectColor): for each
+ * closest hit, the local term (emission + ambient) and, per point light, a
+ * Phong contribution that counts only if its shadow ray is unoccluded; then
+ * the reflected and refracted rays with their path weights. The recursion of
+ * IntersectColor becomes the next queue; the lecture's `else if` between
+ * reflection and refraction becomes both rays, weighted by Fresnel.
+ *
+ * Specialised by -D: RTCL_LIGHT_COUNT=n, RTCL_HAS_SPHERES,
+ * RTCL_HAS_REFLECTION (some material has kr > 0 or kt > 0),
+ * RTCL_HAS_REFRACTION (some material has kt > 0). */
+#include "shared/layouts.h"
+#include "shared/render_layouts.h"
+
+#ifndef RTCL_LIGHT_COUNT
+#define RTCL_LIGHT_COUNT 0
+#endif
+
+/* Safe spawning (after Wächter and Binder, "A Fast and Robust Method for
+ * Avoiding Self-Intersection", Ray Tracing Gems ch. 6): a spawned ray starts
+ * at the hit point moved along the geometric normal by
+ *   offset = FLT_EPSILON * (POINT * |p|_max + EXTENT * extent),
+ * where |p|_max is the largest coordinate magnitude of the hit point and
+ * extent the primitive's size (largest edge component, or the radius). The
+ * hit point is rebuilt from the primitive (barycentrics, or projection onto
+ * the sphere), so its error is about one ulp of |p|_max plus a few ulps of
+ * the extent; moving it and rounding again adds under one ulp of |p|_max
+ * along the normal; the self-test of the next trace errs by a few ulps of
+ * the extent. POINT = 3 and EXTENT = 16 cover those with margin, and scale
+ * with the scene: no fixed epsilon, no self-hit at 1e-4 or 1e5 scale or 1e5
+ * from the origin. */
+#define RTCL_OFFSET_POINT 3.0f
+#define RTCL_OFFSET_EXTENT 16.0f
+/* Shadow rays end this fraction of the distance before the light, so a
+ * light placed on a surface still lights it (t is relative: scale-free). */
+#define RTCL_SHADOW_SHORTEN 1e-4f
+
+inline float3 load3(const float* a) { return (float3)(a[0], a[1], a[2]); }
+inline float3 load3g(global const float* a) { return (float3)(a[0], a[1], a[2]); }
+inline float max3(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
+
+typedef struct SurfacePoint {
+  float3 p;       /* hit point, rebuilt from the primitive */
+  float3 ng;      /* unit geometric normal (triangle winding / sphere outward) */
+  float offset;   /* spawn offset along the normal, world units */
+  uint material;
+} SurfacePoint;
+
+inline SurfacePoint surface_point(const Ray r, const Hit h, global const ShadeTriangle* triangles,
+                                  uint triangle_count, global const ShadeSphere* spheres) {
+  SurfacePoint s;
+#ifdef RTCL_HAS_SPHERES
+  if ((uint)h.prim >= triangle_count) {
+    global const ShadeSphere* sp = spheres + ((uint)h.prim - triangle_count);
+    float3 c = load3g(sp->center);
+    float3 p = (float3)(r.ox, r.oy, r.oz) + h.t * (float3)(r.dx, r.dy, r.dz);
+    s.ng = normalize(p - c);
+    s.p = c + sp->radius * s.ng;
+    s.offset = FLT_EPSILON * (RTCL_OFFSET_POINT * max3(fabs(s.p)) + RTCL_OFFSET_EXTENT * sp->radius);
+    s.material = sp->material;
+    return s;
+  }
+#endif
+  global const ShadeTriangle* t = triangles + h.prim;
+  float3 v0 = load3g(t->v[0]);
+  float3 e1 = load3g(t->v[1]) - v0, e2 = load3g(t->v[2]) - v0;
+  float extent = fmax(max3(fabs(e1)), max3(fabs(e2)));
+  s.p = v0 + h.u * e1 + h.v * e2;
+  float inv = 1.0f / extent; /* scaled before the cross product: no under/overflow at any scene scale */
+  s.ng = normalize(cross(e1 * inv, e2 * inv));
+  s.offset = FLT_EPSILON * (RTCL_OFFSET_POINT * max3(fabs(s.p)) + RTCL_OFFSET_EXTENT * extent);
+  s.material = t->material;
+  return s;
+}
+
+inline Ray make_ray(float3 o, float3 d, float tmax) {
+  Ray r;
+  r.ox = o.x;
+  r.oy = o.y;
+  r.oz = o.z;
+  r.dx = d.x;
+  r.dy = d.y;
+  r.dz = d.z;
+  r.tmin = 0.0f;
+  r.tmax = tmax;
+  return r;
+}
+
+inline void spawn(global Ray* rays, global PathState* paths, global uint* flags, uint slot, float3 o, float3 d,
+                  float3 w, uint depth, uint pixel, uint kind) {
+  rays[slot] = make_ray(o, d, INFINITY);
+  PathState p;
+  p.pixel = pixel;
+  p.depth = depth;
+  p.wr = w.x;
+  p.wg = w.y;
+  p.wb = w.z;
+  paths[slot] = p;
+  flags[slot] = kind;
+}
+
+/* Unpolarised Fresnel reflectance of a dielectric interface; eta = n1 / n2,
+ * cosines of the incident and transmitted angles (both > 0). */
+inline float fresnel_dielectric(float cos_i, float cos_t, float eta) {
+  float rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  float rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  return 0.5f * (rs * rs + rp * rp);
+}
+
+/* Per queued ray i (< count), with its closest hit:
+ *  radiance[i]            weight * (emission + ambient) at the hit, or weight * background on a miss;
+ *  shadow slots i*L + l   a shadow ray towards light l and its unoccluded contribution (flag 1), or flag 0;
+ *  spawn slots 2i, 2i+1   the reflected / refracted ray and path (flag = kind), or flag 0. */
+kernel void shade_hits(global const Ray* rays, global const Hit* hits, global const PathState* paths, uint count,
+                       global const ShadeTriangle* triangles, global const ShadeSphere* spheres,
+                       global const DeviceMaterial* materials, global const DeviceLight* lights,
+                       global const ShadeParams* params, global float4* radiance, global Ray* shadow_rays,
+                       global float4* shadow_weight, global uint* shadow_flags, global Ray* spawn_rays,
+                       global PathState* spawn_paths, global uint* spawn_flags) {
+  uint i = get_global_id(0);
+  if (i >= count) return;
+  for (uint l = 0; l < RTCL_LIGHT_COUNT; ++l) shadow_flags[i * RTCL_LIGHT_COUNT + l] = RTCL_SLOT_EMPTY;
+  spawn_flags[2 * i] = RTCL_SLOT_EMPTY;
+  spawn_flags[2 * i + 1] = RTCL_SLOT_EMPTY;
+
+  ShadeParams P = *params;
+  PathState path = paths[i];
+  float3 w = (float3)(path.wr, path.wg, path.wb);
+  Hit h = hits[i];
+  if (h.prim < 0) {
+    radiance[i] = (float4)(w * load3(P.background), 0.0f);
+    return;
+  }
+  Ray r = rays[i];
+  float3 d = normalize((float3)(r.dx, r.dy, r.dz));
+  SurfacePoint s = surface_point(r, h, triangles, P.triangle_count, spheres);
+  global const DeviceMaterial* m = materials + s.material;
+  float cos_i = -dot(d, s.ng);
+  int front = cos_i > 0.0f; /* the ray arrives on the side the normal points to */
+  float3 n = front ? s.ng : -s.ng;
+  cos_i = fabs(cos_i);
+  float3 above = s.p + s.offset * n; /* origin of rays leaving on the arriving side */
+  radiance[i] = (float4)(w * (load3g(m->emission) + load3(P.ambient) * load3g(m->ambient)), 0.0f);
+
+#if RTCL_LIGHT_COUNT > 0
+  float3 kd = load3g(m->diffuse), ks = load3g(m->specular);
+  for (uint l = 0; l < RTCL_LIGHT_COUNT; ++l) {
+    float3 light_position = load3g(lights[l].position);
+    float3 ld = normalize(light_position - s.p); /* shading from the hit point, not the offset origin */
+    float cos_l = dot(n, ld);
+    if (!(cos_l > 0.0f)) continue;
+    float3 f = kd * cos_l;
+    if (max3(ks) > 0.0f) {
+      float3 mirror = 2.0f * cos_l * n - ld;
+      float rv = fmax(dot(mirror, -d), 0.0f);
+      f += ks * (m->shininess > 0.0f ? pow(rv, m->shininess) : 1.0f);
+    }
+    float3 c = w * load3g(lights[l].radiance) * f;
+    if (!(max3(c) > 0.0f)) continue;
+    uint slot = i * RTCL_LIGHT_COUNT + l;
+    shadow_rays[slot] = make_ray(above, light_position - above, 1.0f - RTCL_SHADOW_SHORTEN);
+    shadow_weight[slot] = (float4)(c, 0.0f);
+    shadow_flags[slot] = RTCL_SLOT_SHADOW;
+  }
+#endif
+
+#ifdef RTCL_HAS_REFLECTION
+  if (path.depth >= P.max_depth) return;
+  float3 wr = w * load3g(m->kr);
+#ifdef RTCL_HAS_REFRACTION
+  float3 kt = load3g(m->kt);
+  if (max3(kt) > 0.0f) {
+    float eta = front ? 1.0f / m->ior : m->ior;
+    float sin2_t = eta * eta * (1.0f - cos_i * cos_i);
+    float F = 1.0f; /* total internal reflection */
+    if (sin2_t < 1.0f) {
+      float cos_t = sqrt(1.0f - sin2_t);
+      F = fresnel_dielectric(cos_i, cos_t, eta);
+      float3 wt = w * kt * (1.0f - F);
+      if (max3(wt) > 0.0f && max3(wt) >= P.min_weight) {
+        float3 td = eta * d + (eta * cos_i - cos_t) * n; /* Snell's law */
+        spawn(spawn_rays, spawn_paths, spawn_flags, 2 * i + 1, s.p - s.offset * n, normalize(td), wt, path.depth + 1,
+              path.pixel, RTCL_SLOT_REFRACTION);
+      }
+    }
+    wr += w * kt * F;
+  }
+#endif
+  if (max3(wr) > 0.0f && max3(wr) >= P.min_weight)
+    spawn(spawn_rays, spawn_paths, spawn_flags, 2 * i, above, d + 2.0f * cos_i * n, wr, path.depth + 1, path.pixel,
+          RTCL_SLOT_REFLECTION);
+#endif
+}
+
+/* Adds each pixel's radiance of this generation to the framebuffer. Rays of
+ * one pixel are contiguous in every queue (tile-order generation, order
+ * preserving compaction), so the first ray of each run sums the run, in
+ * queue order, each ray with its unoccluded light contributions: no atomics,
+ * and the sum's order (hence the image) is deterministic. */
+kernel void accumulate_radiance(global const PathState* paths, uint count, global const float4* radiance,
+                                global const float4* shadow_weight, global const uint* shadow_flags,
+                                global const uint* shadow_index, global const Hit* shadow_hits,
+                                global float4* framebuffer) {
+  uint i = get_global_id(0);
+  if (i >= count) return;
+  uint pixel = paths[i].pixel;
+  if (i > 0 && paths[i - 1].pixel == pixel) return;
+  float4 sum = (float4)(0.0f);
+  for (uint j = i; j < count && paths[j].pixel == pixel; ++j) {
+    sum += radiance[j];
+    for (uint l = 0; l < RTCL_LIGHT_COUNT; ++l) {
+      uint slot = j * RTCL_LIGHT_COUNT + l;
+      if (shadow_flags[slot] != RTCL_SLOT_EMPTY && shadow_hits[shadow_index[slot]].prim < 0)
+        sum += shadow_weight[slot];
+    }
+  }
+  framebuffer[pixel] += sum;
+}

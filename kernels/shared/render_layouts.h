@@ -1,0 +1,140 @@
+/* Records of the wavefront renderer that cross the host/device boundary, and
+ * the integer conventions (screen-tile order, sample jitter) the host
+ * reference renderer must reproduce bit for bit. Same rules as layouts.h:
+ * every field a 4-byte scalar, no float3, host static_asserts in
+ * src/rtcl/render/render_layouts.cpp. Include shared/layouts.h first. */
+#ifndef RTCL_SHARED_RENDER_LAYOUTS_H
+#define RTCL_SHARED_RENDER_LAYOUTS_H
+
+#ifndef __OPENCL_VERSION__
+namespace rtcl {
+#endif
+
+/* One path of the ray tree, parallel to its Ray in a queue: 20 bytes. */
+typedef struct PathState {
+  rtcl_u32 pixel;     /* y * width + x */
+  rtcl_u32 depth;     /* bounces so far: 0 for a camera ray */
+  float wr, wg, wb;   /* path weight (product of kr/kt factors), linear RGB */
+} PathState;
+
+/* Phong material with Whitted reflection and refraction: 80 bytes. Colours
+ * are linear RGB. Reflected rays carry kr + kt * F, refracted rays kt * (1 - F)
+ * (F: exact dielectric Fresnel reflectance; 1 under total internal
+ * reflection). */
+typedef struct DeviceMaterial {
+  float ambient[3], diffuse[3], specular[3], emission[3];
+  float kr[3], kt[3];
+  float shininess; /* Phong exponent */
+  float ior;       /* index of refraction inside the surface (outside: 1) */
+} DeviceMaterial;
+
+/* A point light: 24 bytes. radiance = colour * intensity, not attenuated
+ * with distance (classic Whitted point light). */
+typedef struct DeviceLight {
+  float position[3];
+  float radiance[3];
+} DeviceLight;
+
+/* Pinhole camera for one image: the direction of the ray through image
+ * position (x, y) (pixels, y down, (0, 0) the top-left corner of the top-left
+ * pixel) is corner + x * du + y * dv (not normalised). 56 bytes. */
+typedef struct DeviceCamera {
+  float origin[3];
+  float corner[3];
+  float du[3];
+  float dv[3];
+  rtcl_u32 width, height;
+} DeviceCamera;
+
+/* Constants of the shade kernel: 40 bytes. */
+typedef struct ShadeParams {
+  float ambient[3];    /* ambient light, multiplies each material's ambient */
+  float background[3]; /* radiance of rays that hit nothing */
+  float min_weight;    /* a spawned ray whose weight's largest component is below this is dropped */
+  rtcl_u32 max_depth;  /* bounces allowed after the camera ray's hit */
+  rtcl_u32 triangle_count; /* prim ids below it are triangles, the rest spheres */
+  rtcl_u32 pad;
+} ShadeParams;
+
+/* A triangle as the shade kernel sees it (vertices, for the geometric normal
+ * and the hit point from barycentrics): 40 bytes. */
+typedef struct ShadeTriangle {
+  float v[3][3]; /* v[vertex][axis] */
+  rtcl_u32 material;
+} ShadeTriangle;
+
+/* A sphere as the shade kernel sees it: 20 bytes. */
+typedef struct ShadeSphere {
+  float center[3];
+  float radius;
+  rtcl_u32 material;
+} ShadeSphere;
+
+/* Slot flags written by the shade kernel and read by the compaction: 0 = no
+ * ray, else the kind of ray (counted separately). */
+#define RTCL_SLOT_EMPTY 0u
+#define RTCL_SLOT_SHADOW 1u
+#define RTCL_SLOT_REFLECTION 1u
+#define RTCL_SLOT_REFRACTION 2u
+
+/* Slots per work-item of the compaction kernels (kernels/render/compact.cl). */
+#define RTCL_SCAN_CHUNK 256u
+
+/* Side of the square screen tiles camera rays are generated in. */
+#define RTCL_TILE 8u
+
+/* Pixel (y * width + x) of the i-th camera ray (i < width * height) in
+ * screen-tile order: rows of RTCL_TILE-high tiles from the top, tiles from the
+ * left, pixels row-major inside a tile. Edge tiles are narrower or lower, so
+ * this is a bijection onto the pixels for any size. Consecutive work-items
+ * (packets of 8) are the rows of one tile: coherent rays. */
+inline rtcl_u32 rtcl_tile_order_pixel(rtcl_u32 i, rtcl_u32 width, rtcl_u32 height) {
+  rtcl_u32 tile_row = i / (RTCL_TILE * width);
+  rtcl_u32 rest = i - tile_row * RTCL_TILE * width;
+  rtcl_u32 y0 = tile_row * RTCL_TILE;
+  rtcl_u32 th = height - y0 < RTCL_TILE ? height - y0 : RTCL_TILE;
+  rtcl_u32 tile = rest / (RTCL_TILE * th);
+  rtcl_u32 within = rest - tile * RTCL_TILE * th;
+  rtcl_u32 x0 = tile * RTCL_TILE;
+  rtcl_u32 tw = width - x0 < RTCL_TILE ? width - x0 : RTCL_TILE;
+  rtcl_u32 y = y0 + within / tw;
+  rtcl_u32 x = x0 + within % tw;
+  return y * width + x;
+}
+
+/* Integer mixing function (xorshift-multiply, two rounds): a well-spread
+ * 32-bit value from a 32-bit key. */
+inline rtcl_u32 rtcl_hash(rtcl_u32 x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+/* Position inside its pixel of sample `sample` of `spp` (both in [0, 1)):
+ * the centre for one sample; otherwise jittered stratified sampling on a
+ * k x k grid, k = ceil(sqrt(spp)), one random point in stratum `sample`.
+ * Exact in float: both sides compute the same values. */
+inline void rtcl_sample_position(rtcl_u32 pixel, rtcl_u32 sample, rtcl_u32 spp, float* jx, float* jy) {
+  if (spp <= 1u) {
+    *jx = 0.5f;
+    *jy = 0.5f;
+    return;
+  }
+  rtcl_u32 k = 1u;
+  while (k * k < spp) ++k;
+  rtcl_u32 h1 = rtcl_hash(pixel * 0x9e3779b9u ^ rtcl_hash(sample));
+  rtcl_u32 h2 = rtcl_hash(h1 ^ 0x68bc21ebu);
+  float u = (float)(h1 >> 8) * (1.0f / 16777216.0f);
+  float v = (float)(h2 >> 8) * (1.0f / 16777216.0f);
+  float inv_k = 1.0f / (float)k;
+  *jx = ((float)(sample % k) + u) * inv_k;
+  *jy = ((float)((sample / k) % k) + v) * inv_k;
+}
+
+#ifndef __OPENCL_VERSION__
+} /* namespace rtcl */
+#endif
+#endif

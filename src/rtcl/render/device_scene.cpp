@@ -1,0 +1,80 @@
+#include "rtcl/render/device_scene.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include "rtcl/render/render_layouts.hpp"
+
+namespace rtcl {
+
+namespace {
+
+void store(float* out, const glm::vec3& v) {
+  out[0] = v.x;
+  out[1] = v.y;
+  out[2] = v.z;
+}
+
+DeviceMaterial pack(const Material& m) {
+  DeviceMaterial d{};
+  store(d.ambient, m.ambient);
+  store(d.diffuse, m.diffuse);
+  store(d.specular, m.specular);
+  store(d.emission, m.emission);
+  store(d.kr, m.kr);
+  store(d.kt, m.kt);
+  d.shininess = m.shininess;
+  d.ior = m.ior;
+  return d;
+}
+
+}  // namespace
+
+std::vector<std::string> shade_defines(const Scene& scene, const FlatScene& flat) {
+  std::set<std::uint32_t> used(flat.material.begin(), flat.material.end());
+  bool reflection = false, refraction = false;
+  for (std::uint32_t m : used) {
+    reflection = reflection || scene.materials[m].reflective() || scene.materials[m].transmissive();
+    refraction = refraction || scene.materials[m].transmissive();
+  }
+  std::vector<std::string> defines{"RTCL_LIGHT_COUNT=" + std::to_string(scene.lights.size())};
+  if (!flat.geometry.spheres.empty()) defines.push_back("RTCL_HAS_SPHERES");
+  if (reflection) defines.push_back("RTCL_HAS_REFLECTION");
+  if (refraction) defines.push_back("RTCL_HAS_REFRACTION");
+  return defines;
+}
+
+DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat) {
+  const Geometry& g = flat.geometry;
+  std::vector<ShadeTriangle> triangles(std::max<std::size_t>(g.triangles.size(), 1));
+  for (std::size_t t = 0; t < g.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) store(triangles[t].v[k], g.vertices[g.triangles[t][k]]);
+    triangles[t].material = flat.material[t];
+  }
+  std::vector<ShadeSphere> spheres(std::max<std::size_t>(g.spheres.size(), 1));
+  for (std::size_t s = 0; s < g.spheres.size(); ++s) {
+    store(spheres[s].center, g.spheres[s].center);
+    spheres[s].radius = g.spheres[s].radius;
+    spheres[s].material = flat.material[g.triangles.size() + s];
+  }
+  std::vector<DeviceMaterial> materials;
+  for (const Material& m : scene.materials) materials.push_back(pack(m));
+  if (materials.empty()) materials.emplace_back();
+  std::vector<DeviceLight> lights(std::max<std::size_t>(scene.lights.size(), 1));
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    store(lights[l].position, scene.lights[l].position);
+    store(lights[l].radiance, scene.lights[l].color * scene.lights[l].intensity);
+  }
+  DeviceScene d;
+  d.triangles = device.upload(triangles.data(), triangles.size() * sizeof(ShadeTriangle), "shading triangles");
+  d.spheres = device.upload(spheres.data(), spheres.size() * sizeof(ShadeSphere), "shading spheres");
+  d.materials = device.upload(materials.data(), materials.size() * sizeof(DeviceMaterial), "materials");
+  d.lights = device.upload(lights.data(), lights.size() * sizeof(DeviceLight), "lights");
+  d.triangle_count = static_cast<std::uint32_t>(g.triangles.size());
+  d.sphere_count = static_cast<std::uint32_t>(g.spheres.size());
+  d.light_count = static_cast<std::uint32_t>(scene.lights.size());
+  d.defines = shade_defines(scene, flat);
+  return d;
+}
+
+}  // namespace rtcl

@@ -1,0 +1,30 @@
+// A scene as the shade kernel reads it: per-primitive shading records (in
+// primitive-id order), materials and lights on the device, and the -D options
+// that specialise the renderer's kernels to the scene.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rtcl/cl/device.hpp"
+#include "rtcl/scene/scene.hpp"
+
+namespace rtcl {
+
+struct DeviceScene {
+  cl::Buffer triangles;  // ShadeTriangle per triangle id
+  cl::Buffer spheres;    // ShadeSphere per sphere (id - triangle_count); a placeholder when none
+  cl::Buffer materials;  // DeviceMaterial
+  cl::Buffer lights;     // DeviceLight; a placeholder when none
+  std::uint32_t triangle_count = 0, sphere_count = 0, light_count = 0;
+  // RTCL_LIGHT_COUNT=n always; RTCL_HAS_SPHERES with spheres;
+  // RTCL_HAS_REFLECTION when some primitive's material has kr > 0 or kt > 0;
+  // RTCL_HAS_REFRACTION when some primitive's material has kt > 0.
+  std::vector<std::string> defines;
+};
+
+std::vector<std::string> shade_defines(const Scene& scene, const FlatScene& flat);
+DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat);
+
+}  // namespace rtcl

@@ -1,0 +1,20 @@
+// Compile-time proof that the host sees the renderer's device records
+// (kernels/shared/render_layouts.h) with the sizes and offsets the kernels use.
+#include "rtcl/render/render_layouts.hpp"
+
+#include <cstddef>
+
+namespace rtcl {
+
+static_assert(sizeof(PathState) == 20 && alignof(PathState) == 4);
+static_assert(offsetof(PathState, depth) == 4 && offsetof(PathState, wr) == 8 && offsetof(PathState, wb) == 16);
+static_assert(sizeof(DeviceMaterial) == 80 && offsetof(DeviceMaterial, kr) == 48 &&
+              offsetof(DeviceMaterial, shininess) == 72 && offsetof(DeviceMaterial, ior) == 76);
+static_assert(sizeof(DeviceLight) == 24 && offsetof(DeviceLight, radiance) == 12);
+static_assert(sizeof(DeviceCamera) == 56 && offsetof(DeviceCamera, dv) == 36 && offsetof(DeviceCamera, width) == 48);
+static_assert(sizeof(ShadeParams) == 40 && offsetof(ShadeParams, min_weight) == 24 &&
+              offsetof(ShadeParams, triangle_count) == 32);
+static_assert(sizeof(ShadeTriangle) == 40 && offsetof(ShadeTriangle, material) == 36);
+static_assert(sizeof(ShadeSphere) == 20 && offsetof(ShadeSphere, radius) == 12 && offsetof(ShadeSphere, material) == 16);
+
+}  // namespace rtcl

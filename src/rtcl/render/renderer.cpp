@@ -1,0 +1,318 @@
+#include "rtcl/render/renderer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "rtcl/error.hpp"
+#include "rtcl/render/camera.hpp"
+#include "rtcl/render/device_scene.hpp"
+#include "rtcl/render/launch.hpp"
+#include "rtcl/render/ray_queue.hpp"
+#include "rtcl/render/render_layouts.hpp"
+
+namespace rtcl {
+
+namespace {
+
+const std::vector<cl::Event>* wait_list(const std::vector<cl::Event>& wait) { return wait.empty() ? nullptr : &wait; }
+
+void store(float* out, const glm::dvec3& v) {
+  out[0] = static_cast<float>(v.x);
+  out[1] = static_cast<float>(v.y);
+  out[2] = static_cast<float>(v.z);
+}
+
+double event_ms(const cl::Event& e) {
+  auto start = e.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+  auto end = e.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+  return end > start ? static_cast<double>(end - start) * 1e-6 : 0.0;
+}
+
+void check_settings(const RenderSettings& s) {
+  if (s.width == 0 || s.height == 0 || s.width > 65536 || s.height > 65536 ||
+      std::uint64_t(s.width) * s.height > (1u << 28))
+    throw Error("image size " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                ": width and height must be 1 .. 65536 and the image at most 2^28 pixels");
+  if (s.spp == 0 || s.spp > 65536) throw Error("spp " + std::to_string(s.spp) + ": must be 1 .. 65536");
+  if (s.max_depth > 64) throw Error("depth " + std::to_string(s.max_depth) + ": must be 0 .. 64");
+  if (!std::isfinite(s.min_weight) || s.min_weight < 0.0f)
+    throw Error("min weight " + std::to_string(s.min_weight) + ": must be finite and not negative");
+  if (s.batch_pixels == 0) throw Error("batch size must be positive");
+}
+
+}  // namespace
+
+struct Renderer::State {
+  Device device;
+  Scene scene;
+  FlatScene flat;
+  std::unique_ptr<Accel> accel;
+  DeviceScene shading;
+  cl::Kernel shade, accumulate;
+
+  // Per render.
+  RenderSettings settings;
+  cl::Buffer camera, params, framebuffer, totals;
+  // Per generation: queue -> hits -> radiance + slots -> next queue + shadow queue.
+  RayQueue queue, next;
+  GrowingBuffer hits{"hits", sizeof(Hit)}, radiance{"path radiance", 16};
+  SpawnSlots spawn;
+  ShadowSlots shadow_slots;
+  ShadowQueue shadows;
+  std::vector<cl::Event> last;  // what the next stage waits for
+
+  RenderStats stats;
+  std::vector<cl::Event> camera_traces, secondary_traces, shadow_traces, generates, shades, accumulates;
+  std::vector<std::pair<cl::Event, cl::Event>> compacts;  // first and last kernel of both compactions
+
+  State(const Device& d, const Scene& s) : device(d), scene(s), queue(d), next(d), shadows(d) {}
+};
+
+Renderer::Renderer(const Device& device, const Scene& scene, std::string_view accel_name)
+    : s_(std::make_unique<State>(device, scene)) {
+  s_->flat = flatten(scene);
+  s_->accel = make_accel(device, accel_name, s_->flat.geometry);
+  s_->shading = upload_scene(device, scene, s_->flat);
+  with_cl_errors([&] {
+    cl::Program program = device.program("render/shade.cl", s_->shading.defines);
+    s_->shade = cl::Kernel(program, "shade_hits");
+    s_->accumulate = cl::Kernel(program, "accumulate_radiance");
+    s_->totals = device.allocate(4 * sizeof(cl_uint), "compaction totals");
+  });
+}
+
+Renderer::~Renderer() = default;
+
+const RenderStats& Renderer::stats() const { return s_->stats; }
+const Accel& Renderer::accel() const { return *s_->accel; }
+const std::vector<std::string>& Renderer::defines() const { return s_->shading.defines; }
+
+// Per render: camera, shading constants, a cleared framebuffer.
+void Renderer::prepare(const RenderSettings& settings) {
+  check_settings(settings);
+  State& s = *s_;
+  s.settings = settings;
+  s.stats = RenderStats{};
+  const std::uint32_t pixels = settings.width * settings.height;
+  CameraFrame frame = camera_frame(s.scene.camera, settings.width, settings.height);
+  DeviceCamera camera{};
+  store(camera.origin, frame.origin);
+  store(camera.corner, frame.corner);
+  store(camera.du, frame.du);
+  store(camera.dv, frame.dv);
+  camera.width = settings.width;
+  camera.height = settings.height;
+  ShadeParams params{};
+  store(params.ambient, glm::dvec3(s.scene.ambient));
+  store(params.background, glm::dvec3(s.scene.background));
+  params.min_weight = settings.min_weight;
+  params.max_depth = settings.max_depth;
+  params.triangle_count = s.shading.triangle_count;
+  s.camera = s.device.upload(&camera, sizeof camera, "camera");
+  s.params = s.device.upload(&params, sizeof params, "shading parameters");
+  s.framebuffer = s.device.allocate(std::size_t(pixels) * 16, "framebuffer");
+  with_cl_errors([&] {
+    cl::Event cleared;
+    s.device.queue().enqueueFillBuffer(s.framebuffer, cl_float4{}, 0, std::size_t(pixels) * 16, nullptr, &cleared);
+    s.last = {cleared};
+  });
+}
+
+Image Renderer::render(const RenderSettings& settings, const RenderProgress& progress) {
+  auto start = std::chrono::steady_clock::now();
+  prepare(settings);
+  State& s = *s_;
+  const std::uint32_t pixels = settings.width * settings.height;
+  const double total_work = double(pixels) * settings.spp;
+  for (std::uint32_t sample = 0; sample < settings.spp; ++sample)
+    for (std::uint32_t first = 0; first < pixels; first += settings.batch_pixels) {
+      std::uint32_t count = std::min(settings.batch_pixels, pixels - first);
+      double done = double(sample) * pixels + first;
+      generate(first, count, sample);
+      for (std::uint32_t generation = 0; s.queue.size() > 0; ++generation) {
+        trace(generation == 0);
+        shade();
+        compact();
+        trace_shadows();
+        accumulate();
+        std::swap(s.queue, s.next);
+        s.stats.generations++;
+        if (progress)
+          progress((done + count * std::min(1.0, (generation + 1.0) / (settings.max_depth + 1.0))) / total_work);
+      }
+      collect_times();
+    }
+
+  std::vector<cl_float4> sums(pixels);
+  with_cl_errors([&] {
+    s.device.queue().enqueueReadBuffer(s.framebuffer, CL_TRUE, 0, sums.size() * 16, sums.data(), wait_list(s.last));
+  });
+  Image image;
+  image.width = settings.width;
+  image.height = settings.height;
+  image.rgb.resize(std::size_t(pixels) * 3);
+  const float inv = 1.0f / static_cast<float>(settings.spp);
+  for (std::size_t p = 0; p < pixels; ++p)
+    for (int c = 0; c < 3; ++c) image.rgb[p * 3 + c] = sums[p].s[c] * inv;
+  s.stats.queue_bytes = s.queue.bytes() + s.next.bytes() + s.shadows.bytes() + s.hits.bytes() +
+                        s.radiance.bytes() + s.spawn.rays.bytes() + s.spawn.paths.bytes() + s.spawn.flags.bytes() +
+                        s.shadow_slots.rays.bytes() + s.shadow_slots.weights.bytes() +
+                        s.shadow_slots.flags.bytes() + s.shadow_slots.index.bytes();
+  s.stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (progress) progress(1.0);
+  return image;
+}
+
+std::vector<std::vector<TreeRay>> Renderer::ray_tree(const Ray& ray, const RenderSettings& settings) {
+  prepare(settings);
+  State& s = *s_;
+  std::vector<std::vector<TreeRay>> tree;
+  std::vector<Ray> rays{ray};
+  std::vector<PathState> paths{PathState{0, 0, 1.0f, 1.0f, 1.0f}};
+  s.queue.assign(rays, paths);
+  while (s.queue.size() > 0) {
+    s.queue.read(rays, paths, s.last);
+    tree.emplace_back();
+    for (std::size_t i = 0; i < rays.size(); ++i) tree.back().push_back(TreeRay{rays[i], paths[i]});
+    trace(tree.size() == 1);
+    shade();
+    compact();
+    trace_shadows();
+    accumulate();
+    std::swap(s.queue, s.next);
+  }
+  collect_times();
+  return tree;
+}
+
+// generate: camera rays of one batch, in screen-tile order.
+void Renderer::generate(std::uint32_t first, std::uint32_t count, std::uint32_t sample) {
+  State& s = *s_;
+  cl::Event e = s.queue.generate_camera_rays(s.camera, first, count, sample, s.settings.spp, s.last);
+  s.generates.push_back(e);
+  s.last = {e};
+  s.stats.rays.camera += count;
+}
+
+// trace: closest hit of every queued ray.
+void Renderer::trace(bool camera_rays) {
+  State& s = *s_;
+  std::size_t n = s.queue.size();
+  s.stats.peak_queue = std::max(s.stats.peak_queue, n);
+  const cl::Buffer& hits = s.hits.reserve(s.device, n);
+  cl::Event e = s.accel->trace(Query::closest, s.queue.rays(), hits, n, s.last);
+  (camera_rays ? s.camera_traces : s.secondary_traces).push_back(e);
+  s.last = {e};
+}
+
+// shade: local term, shadow-ray candidates, reflected and refracted rays.
+void Renderer::shade() {
+  State& s = *s_;
+  std::size_t n = s.queue.size();
+  s.radiance.reserve(s.device, n);
+  s.shadow_slots.reserve(s.device, std::max<std::size_t>(n * s.shading.light_count, 1));
+  s.shadow_slots.count = n * s.shading.light_count;
+  s.spawn.reserve(s.device, 2 * n);
+  with_cl_errors([&] {
+    cl::Kernel& k = s.shade;
+    cl_uint a = 0;
+    k.setArg(a++, s.queue.rays());
+    k.setArg(a++, s.hits.buffer());
+    k.setArg(a++, s.queue.paths());
+    k.setArg(a++, static_cast<cl_uint>(n));
+    k.setArg(a++, s.shading.triangles);
+    k.setArg(a++, s.shading.spheres);
+    k.setArg(a++, s.shading.materials);
+    k.setArg(a++, s.shading.lights);
+    k.setArg(a++, s.params);
+    k.setArg(a++, s.radiance.buffer());
+    k.setArg(a++, s.shadow_slots.rays.buffer());
+    k.setArg(a++, s.shadow_slots.weights.buffer());
+    k.setArg(a++, s.shadow_slots.flags.buffer());
+    k.setArg(a++, s.spawn.rays.buffer());
+    k.setArg(a++, s.spawn.paths.buffer());
+    k.setArg(a++, s.spawn.flags.buffer());
+    cl::Event e = launch(s.device, k, n, s.last);
+    s.shades.push_back(e);
+    s.last = {e};
+  });
+}
+
+// compact: flagged slots -> the dense shadow queue and the next ray queue;
+// their sizes are read back (the only host synchronisation per generation).
+void Renderer::compact() {
+  State& s = *s_;
+  cl::Event first;
+  cl::Event shadows = s.shadows.compact_from(s.shadow_slots, s.totals, 0, s.last, &first);
+  cl::Event spawned = s.next.compact_from(s.spawn, s.totals, 2, {shadows});
+  s.compacts.push_back({first, spawned});
+  cl_uint totals[4] = {0, 0, 0, 0};
+  std::vector<cl::Event> wait{spawned};
+  with_cl_errors(
+      [&] { s.device.queue().enqueueReadBuffer(s.totals, CL_TRUE, 0, sizeof totals, totals, &wait); });
+  s.shadows.set_size(totals[0]);
+  s.next.set_size(totals[2]);
+  s.stats.rays.shadow += totals[0];
+  s.stats.rays.refraction += totals[3];
+  s.stats.rays.reflection += totals[2] - totals[3];
+  s.last = {spawned};
+}
+
+// trace_shadows: any hit of every shadow ray.
+void Renderer::trace_shadows() {
+  State& s = *s_;
+  if (s.shadows.size() == 0) return;
+  cl::Event e = s.accel->trace(Query::any, s.shadows.rays(), s.shadows.hits(), s.shadows.size(), s.last);
+  s.shadow_traces.push_back(e);
+  s.last = {e};
+}
+
+// accumulate: this generation's radiance, per pixel, into the framebuffer.
+void Renderer::accumulate() {
+  State& s = *s_;
+  std::size_t n = s.queue.size();
+  with_cl_errors([&] {
+    cl::Kernel& k = s.accumulate;
+    cl_uint a = 0;
+    k.setArg(a++, s.queue.paths());
+    k.setArg(a++, static_cast<cl_uint>(n));
+    k.setArg(a++, s.radiance.buffer());
+    k.setArg(a++, s.shadow_slots.weights.buffer());
+    k.setArg(a++, s.shadow_slots.flags.buffer());
+    k.setArg(a++, s.shadow_slots.index.buffer());
+    k.setArg(a++, s.shadows.size() > 0 ? s.shadows.hits() : s.hits.buffer());
+    k.setArg(a++, s.framebuffer);
+    cl::Event e = launch(s.device, k, n, s.last);
+    s.accumulates.push_back(e);
+    s.last = {e};
+  });
+}
+
+// Adds the device times of the finished stages to the stats.
+void Renderer::collect_times() {
+  State& s = *s_;
+  with_cl_errors([&] { cl::WaitForEvents(s.last); });
+  auto sum = [&](std::vector<cl::Event>& events, double& ms) {
+    if (s.device.profiling()) with_cl_errors([&] {
+        for (const cl::Event& e : events) ms += event_ms(e);
+      });
+    events.clear();
+  };
+  sum(s.camera_traces, s.stats.camera_trace_ms);
+  sum(s.secondary_traces, s.stats.secondary_trace_ms);
+  sum(s.shadow_traces, s.stats.shadow_trace_ms);
+  sum(s.generates, s.stats.generate_ms);
+  sum(s.shades, s.stats.shade_ms);
+  if (s.device.profiling()) with_cl_errors([&] {
+      for (const auto& [first, last] : s.compacts) {
+        auto start = first.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+        auto end = last.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+        s.stats.compact_ms += end > start ? static_cast<double>(end - start) * 1e-6 : 0.0;
+      }
+    });
+  s.compacts.clear();
+  sum(s.accumulates, s.stats.accumulate_ms);
+}
+
+}  // namespace rtcl

@@ -1,0 +1,111 @@
+// Whitted ray tracing on the device as wavefront queues (lecture:
+// IntersectColor). Per batch of camera rays:
+//
+//   generate ─► queue ─► trace (closest) ─► shade ─┬─► shadow slots ─► compact ─► trace (any) ─┐
+//                 ▲                                 │                                          ▼
+//                 └────────── compact ◄── spawn slots (reflection, refraction)     accumulate ─► framebuffer
+//
+// until the queue is empty or every path reached the depth limit. Each stage
+// is one function of Renderer; the kernels are built with -D options from
+// the scene (no refraction code without transmissive materials, no sphere
+// code without spheres, the light loop unrolled).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/cl/device.hpp"
+#include "rtcl/render/image.hpp"
+#include "rtcl/render/render_layouts.hpp"
+#include "rtcl/scene/scene.hpp"
+
+namespace rtcl {
+
+struct RenderSettings {
+  std::uint32_t width = 512, height = 512;
+  // Jittered (stratified) samples per pixel; 1 traces pixel centres.
+  std::uint32_t spp = 1;
+  // Reflection/refraction bounces after the camera ray's hit (0: local
+  // shading and shadows only). Speed/accuracy knob.
+  std::uint32_t max_depth = 5;
+  // A spawned ray whose path weight's largest component is below this is
+  // dropped: its contribution (at most this times the radiance it would
+  // bring) is lost. Speed/accuracy knob; 0 keeps every ray.
+  float min_weight = 1e-3f;
+  // Camera rays per wavefront: more gives the device more parallel work and
+  // costs about 300 bytes of queue memory per ray and light.
+  std::uint32_t batch_pixels = 1u << 17;
+};
+
+struct RayCounts {
+  std::uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0;
+  std::uint64_t total() const { return camera + shadow + reflection + refraction; }
+};
+
+struct RenderStats {
+  RayCounts rays;
+  double render_ms = 0.0;  // wall clock of render(), kernels and transfers included
+  // Device time of the kernels by stage (0 when the queue has no profiling);
+  // compact_ms spans both compactions of a generation, first kernel start to
+  // last kernel end.
+  double camera_trace_ms = 0.0, secondary_trace_ms = 0.0, shadow_trace_ms = 0.0;
+  double generate_ms = 0.0, shade_ms = 0.0, compact_ms = 0.0, accumulate_ms = 0.0;
+  std::size_t peak_queue = 0;     // largest queue of camera/secondary rays
+  std::size_t queue_bytes = 0;    // device memory of queues and slots at the end
+  std::uint32_t generations = 0;  // trace rounds over all batches
+};
+
+// One ray of a ray tree (Renderer::ray_tree).
+struct TreeRay {
+  Ray ray;         // origin after the safe offset; unit direction
+  PathState path;  // pixel, depth, weight
+};
+
+// Called with the fraction of the work done, in [0, 1], after each
+// generation of each batch.
+using RenderProgress = std::function<void(double fraction)>;
+
+class Renderer {
+ public:
+  // Flattens and validates the scene, builds the named acceleration
+  // structure over it and the kernels specialised to it. Throws Error.
+  Renderer(const Device& device, const Scene& scene, std::string_view accel_name);
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Renders the scene; deterministic for a given device and settings.
+  // Throws Error naming the setting for an invalid one.
+  Image render(const RenderSettings& settings, const RenderProgress& progress = {});
+
+  // The ray tree of one ray, for inspection and tests: generation 0 is
+  // `ray` (weight 1, depth 0), generation g + 1 the reflected and refracted
+  // rays that generation g spawns on the device (settings.max_depth and
+  // min_weight apply), in queue order: per parent, reflection before
+  // refraction. Ends with the first empty generation (not included).
+  std::vector<std::vector<TreeRay>> ray_tree(const Ray& ray, const RenderSettings& settings);
+
+  const RenderStats& stats() const;          // of the last render
+  const Accel& accel() const;
+  const std::vector<std::string>& defines() const;  // the shade kernel's -D options
+
+ private:
+  struct State;
+  std::unique_ptr<State> s_;
+
+  void prepare(const RenderSettings& settings);
+  void generate(std::uint32_t first, std::uint32_t count, std::uint32_t sample);
+  void trace(bool camera_rays);
+  void shade();
+  void compact();
+  void trace_shadows();
+  void accumulate();
+  void collect_times();
+};
+
+}  // namespace rtcl

@@ -1,0 +1,138 @@
+#include "rtcl/scene/scene.hpp"
+
+#include <cmath>
+
+#include "rtcl/error.hpp"
+
+namespace rtcl {
+
+namespace {
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+void check_colour(const Scene& scene, const std::string& where, const glm::vec3& c) {
+  if (!finite(c) || c.x < 0.0f || c.y < 0.0f || c.z < 0.0f)
+    throw Error(scene.source + ": " + where + " must be finite and not negative");
+}
+
+void check_unit(const Scene& scene, const std::string& where, const glm::vec3& c) {
+  check_colour(scene, where, c);
+  if (c.x > 1.0f || c.y > 1.0f || c.z > 1.0f) throw Error(scene.source + ": " + where + " must lie in [0, 1]");
+}
+
+void validate_camera(const Scene& scene) {
+  const Camera& c = scene.camera;
+  std::string where = scene.source + ": camera: ";
+  if (!finite(c.position) || !finite(c.look_at) || !finite(c.up) || !std::isfinite(c.fov_deg) ||
+      !std::isfinite(c.aspect))
+    throw Error(where + "numbers must be finite");
+  glm::dvec3 view = glm::dvec3(c.look_at) - glm::dvec3(c.position);
+  if (glm::length(view) == 0.0) throw Error(where + "position and look_at are the same point");
+  if (glm::length(glm::cross(glm::normalize(view), glm::dvec3(c.up))) < 1e-6)
+    throw Error(where + "up is zero or parallel to the view direction");
+  if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f)) throw Error(where + "fov must lie in (0, 180) degrees");
+  if (c.aspect < 0.0f) throw Error(where + "aspect must be positive");
+}
+
+void validate_material(const Scene& scene, std::size_t i) {
+  const Material& m = scene.materials[i];
+  std::string where = "material '" + m.name + "' ";
+  check_colour(scene, where + "ambient", m.ambient);
+  check_colour(scene, where + "diffuse", m.diffuse);
+  check_colour(scene, where + "specular", m.specular);
+  check_colour(scene, where + "emission", m.emission);
+  check_unit(scene, where + "kr", m.kr);
+  check_unit(scene, where + "kt", m.kt);
+  if (!std::isfinite(m.shininess) || m.shininess < 0.0f)
+    throw Error(scene.source + ": " + where + "shininess must be finite and not negative");
+  if (!std::isfinite(m.ior) || !(m.ior > 0.0f))
+    throw Error(scene.source + ": " + where + "ior must be positive (got " + std::to_string(m.ior) + ")");
+}
+
+glm::vec3 apply_point(const glm::dmat4& m, const glm::vec3& p) { return glm::vec3(m * glm::dvec4(glm::dvec3(p), 1.0)); }
+
+}  // namespace
+
+double similarity_scale(const glm::dmat4& t, const std::string& what) {
+  glm::dmat3 a(t);
+  double s = std::cbrt(std::abs(glm::determinant(a)));
+  glm::dmat3 r = glm::transpose(a) * a;  // s^2 * identity for a similarity
+  bool ok = std::isfinite(s) && s > 0.0 && t[0][3] == 0.0 && t[1][3] == 0.0 && t[2][3] == 0.0 && t[3][3] == 1.0;
+  for (int i = 0; ok && i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (std::abs(r[i][j] - (i == j ? s * s : 0.0)) > 1e-9 * s * s) ok = false;
+  if (!ok) throw Error(what + ": the transform must be a rotation, uniform scale and translation");
+  return s;
+}
+
+void validate(const Scene& scene) {
+  validate_camera(scene);
+  check_colour(scene, "ambient", scene.ambient);
+  check_colour(scene, "background", scene.background);
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+    const PointLight& l = scene.lights[i];
+    std::string where = "lights[" + std::to_string(i) + "] ";
+    if (!finite(l.position)) throw Error(scene.source + ": " + where + "position must be finite");
+    check_colour(scene, where + "color", l.color);
+    if (!std::isfinite(l.intensity) || l.intensity < 0.0f)
+      throw Error(scene.source + ": " + where + "intensity must be finite and not negative");
+  }
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) validate_material(scene, i);
+  for (const SceneMesh& mesh : scene.meshes) {
+    if (mesh.materials.size() != mesh.triangles.size())
+      throw Error(scene.source + ": mesh " + mesh.name + ": one material per triangle expected");
+    for (std::uint32_t m : mesh.materials)
+      if (m >= scene.materials.size())
+        throw Error(scene.source + ": mesh " + mesh.name + ": material index " + std::to_string(m) + " out of range");
+  }
+  for (std::size_t i = 0; i < scene.spheres.size(); ++i) {
+    const SceneSphere& s = scene.spheres[i];
+    if (s.material >= scene.materials.size())
+      throw Error(scene.source + ": sphere " + std::to_string(i) + ": material index out of range");
+    if (!std::isfinite(s.radius) || !(s.radius > 0.0) || !std::isfinite(s.center.x + s.center.y + s.center.z))
+      throw Error(scene.source + ": sphere " + std::to_string(i) + " needs a finite centre and a positive radius");
+  }
+  if (scene.meshes.empty() && scene.spheres.empty()) throw Error(scene.source + ": the scene has no mesh and no sphere");
+}
+
+FlatScene flatten(const Scene& scene) {
+  validate(scene);
+  FlatScene flat;
+  flat.geometry.source = scene.source;
+  for (const SceneMesh& mesh : scene.meshes) {
+    auto base = static_cast<std::uint32_t>(flat.geometry.vertices.size());
+    // A mirroring transform reverses the winding: swap two corners so that
+    // faces keep facing outward (refraction tells inside from outside by it).
+    bool mirrored = glm::determinant(glm::dmat3(mesh.transform)) < 0.0;
+    for (const glm::vec3& v : mesh.vertices) flat.geometry.vertices.push_back(apply_point(mesh.transform, v));
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      glm::uvec3 tri = mesh.triangles[t] + glm::uvec3(base);
+      if (mirrored) std::swap(tri.y, tri.z);
+      flat.geometry.triangles.push_back(tri);
+      flat.material.push_back(mesh.materials[t]);
+    }
+  }
+  for (const SceneSphere& s : scene.spheres) {
+    flat.geometry.spheres.push_back(Sphere{glm::vec3(s.center), static_cast<float>(s.radius)});
+    flat.material.push_back(s.material);
+  }
+  validate(flat.geometry);
+  return flat;
+}
+
+Scene transform_scene(const Scene& scene, const glm::dmat4& t) {
+  double s = similarity_scale(t, scene.source);
+  Scene out = scene;
+  out.camera.position = apply_point(t, scene.camera.position);
+  out.camera.look_at = apply_point(t, scene.camera.look_at);
+  out.camera.up = glm::vec3(glm::dmat3(t) * glm::dvec3(scene.camera.up) / s);
+  for (PointLight& l : out.lights) l.position = apply_point(t, l.position);
+  for (SceneMesh& m : out.meshes) m.transform = t * m.transform;
+  for (SceneSphere& sp : out.spheres) {
+    sp.center = glm::dvec3(t * glm::dvec4(sp.center, 1.0));
+    sp.radius *= s;
+  }
+  return out;
+}
+
+}  // namespace rtcl

@@ -1,0 +1,101 @@
+// The scene model of the renderer: a pinhole camera, point lights, Phong
+// materials with Whitted reflection/refraction, triangle meshes with
+// per-object transforms and analytic spheres; and its flattening into the
+// Geometry the acceleration structures are built over, with one material per
+// primitive. Units: lengths in scene units, angles in degrees, colours linear
+// RGB.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rtcl/scene/geometry.hpp"
+
+namespace rtcl {
+
+struct Material {
+  std::string name;
+  glm::vec3 ambient{0.0f};   // multiplied by Scene::ambient
+  glm::vec3 diffuse{0.8f};   // Lambert term per light
+  glm::vec3 specular{0.0f};  // Phong term per light: specular * max(0, R.V)^shininess
+  float shininess = 32.0f;   // Phong exponent, >= 0
+  glm::vec3 emission{0.0f};  // added where a ray hits the surface
+  glm::vec3 kr{0.0f};        // mirror reflectance, each in [0, 1]
+  glm::vec3 kt{0.0f};        // transmittance, each in [0, 1]; Fresnel splits it into reflection and refraction
+  float ior = 1.5f;          // index of refraction inside the surface (> 0; outside is 1)
+
+  bool reflective() const { return glm::any(glm::greaterThan(kr, glm::vec3(0.0f))); }
+  bool transmissive() const { return glm::any(glm::greaterThan(kt, glm::vec3(0.0f))); }
+};
+
+struct PointLight {
+  glm::vec3 position{0.0f};
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;  // radiance = color * intensity, no distance falloff
+};
+
+struct Camera {
+  glm::vec3 position{0.0f, 0.0f, 5.0f};
+  glm::vec3 look_at{0.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  float fov_deg = 45.0f;  // vertical field of view, in (0, 180)
+  float aspect = 0.0f;    // width / height the scene is framed for; 0: none (the image decides)
+};
+
+// A triangle mesh in object space with its object-to-world transform.
+struct SceneMesh {
+  std::string name;  // the file path or a built-in name: named in errors
+  std::vector<glm::vec3> vertices;
+  std::vector<glm::uvec3> triangles;
+  std::vector<std::uint32_t> materials;  // one per triangle, index into Scene::materials
+  glm::dmat4 transform{1.0};             // object to world; a mirroring one keeps faces outward
+};
+
+// A sphere in world space (spheres are transformed when loaded).
+struct SceneSphere {
+  glm::dvec3 center{0.0};
+  double radius = 1.0;
+  std::uint32_t material = 0;
+};
+
+struct Scene {
+  std::string source = "scene";  // the scene file, or "default scene": named in errors
+  Camera camera;
+  glm::vec3 ambient{0.0f};     // ambient light
+  glm::vec3 background{0.0f};  // radiance of rays that leave the scene
+  std::vector<PointLight> lights;
+  std::vector<Material> materials;
+  std::vector<SceneMesh> meshes;
+  std::vector<SceneSphere> spheres;
+  std::vector<std::string> notes;  // things the user should know (mesh loader quirks), never errors
+};
+
+// Throws Error naming scene.source and the element for: a degenerate camera
+// (position = look_at, up parallel to the view, fov outside (0, 180)), a
+// negative colour or intensity, kr/kt outside [0, 1], ior <= 0, a negative
+// shininess, a material index out of range, a non-finite number anywhere,
+// or a scene with no mesh and no sphere.
+void validate(const Scene& scene);
+
+// The world-space primitives: mesh triangles in mesh order (transformed in
+// double, rounded to float), then spheres; material[prim] for every
+// primitive id. Geometry::source is scene.source.
+struct FlatScene {
+  Geometry geometry;
+  std::vector<std::uint32_t> material;
+};
+FlatScene flatten(const Scene& scene);
+
+// The scene moved by a similarity transform (rotation, uniform scale,
+// translation): camera, lights, meshes and spheres. Throws Error when
+// `transform` is not a similarity. For scale and translation tests.
+Scene transform_scene(const Scene& scene, const glm::dmat4& transform);
+
+// The uniform scale of a similarity transform; throws Error naming `what`
+// when the 3x3 part is not a rotation times a positive scale.
+double similarity_scale(const glm::dmat4& transform, const std::string& what);
+
+}  // namespace rtcl

@@ -1,0 +1,444 @@
+// The wavefront renderer against the double-precision host reference, the
+// refraction rules on single rays, scale invariance, specialisation and the
+// `rtcl render` command.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "rtcl/error.hpp"
+#include "rtcl/render/image.hpp"
+#include "rtcl/render/render_layouts.hpp"
+#include "rtcl/render/renderer.hpp"
+#include "rtcl/scene/default_scene.hpp"
+#include "rtcl/scene/scene_file.hpp"
+#include "support/fixtures.hpp"
+#include "support/reference_renderer.hpp"
+#include "support/temp_dir.hpp"
+
+namespace rtcl::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+RenderSettings small(std::uint32_t size, std::uint32_t spp = 1) {
+  RenderSettings s;
+  s.width = s.height = size;
+  s.spp = spp;
+  return s;
+}
+
+// Thresholds of a device image against the reference (linear radiance; lit
+// surfaces are 0.1 .. 1, the lamp 3):
+//  - pixels whose ray tree is stable within 0.01 pixel differ only by float
+//    rounding (~1e-6 relative, amplified up to ~300x by Phong exponents up
+//    to 300) and by the device's larger spawn offset (~1e-5 scene units):
+//    max error 1e-3 (measured: 1.4e-5 default scene, 2.5e-5 Cornell box);
+//  - pixels on an edge, silhouette or shadow boundary (the ray tree changes
+//    within 0.01 pixel) may take the other side in float and differ by
+//    anything; they must be few: at most 2% of all pixels off by more than
+//    0.05 (measured 1.0% default scene, whose symmetric box puts pixel
+//    centres exactly on its corner edges; 0.3% Cornell box), hence an RMSE
+//    up to sqrt(0.02 * 0.35^2) ~ 0.05.
+constexpr double max_unambiguous_error = 1e-3;
+constexpr double max_fraction_over = 0.02;
+constexpr double max_rmse = 0.05;
+
+void expect_matches_reference(const Scene& scene, const RenderSettings& settings, const std::string& what) {
+  ReferenceImage ref = reference_render(scene, settings);
+  for (const std::string& accel : accel_names()) {
+    Renderer renderer(test_device(), scene, accel);
+    Image image = renderer.render(settings);
+    ImageDifference d = compare_images(image, ref.image, ref.ambiguous);
+    double pixels = double(settings.width) * settings.height;
+    std::printf("[ measure  ] %s, %s: rmse %.5f, max %.4f, max unambiguous %.2e, ambiguous %zu, over 0.05: %zu of %.0f\n",
+                what.c_str(), accel.c_str(), d.rmse, d.max_error, d.max_error_unmasked, d.masked_pixels,
+                d.pixels_over, pixels);
+    EXPECT_LE(d.max_error_unmasked, max_unambiguous_error) << what << ", " << accel;
+    EXPECT_LE(d.pixels_over, max_fraction_over * pixels) << what << ", " << accel;
+    EXPECT_LE(d.rmse, max_rmse) << what << ", " << accel;
+    EXPECT_LT(d.masked_pixels, 0.25 * pixels) << what << ": the ambiguity test must leave most pixels checked";
+  }
+}
+
+TEST(Render, DefaultSceneMatchesReferenceForEveryAccel) {
+  expect_matches_reference(default_scene(), small(64), "default scene");
+}
+
+TEST(Render, CornellSceneFileMatchesReferenceForEveryAccel) {
+  Scene scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
+  expect_matches_reference(scene, small(48), "scenes/cornell.json");
+}
+
+TEST(Render, JitteredSamplesMatchReference) {
+  RenderSettings s = small(24, 4);
+  Scene scene = default_scene();
+  ReferenceImage ref = reference_render(scene, s);
+  Renderer renderer(test_device(), scene, accel_names().back());
+  ImageDifference d = compare_images(renderer.render(s), ref.image, ref.ambiguous);
+  EXPECT_LE(d.max_error_unmasked, max_unambiguous_error);
+  EXPECT_LE(d.rmse, max_rmse);
+}
+
+
+// --- refraction on single rays (Renderer::ray_tree) --------------------------
+
+// An axis-aligned box with outward faces.
+SceneMesh box_mesh(glm::vec3 lo, glm::vec3 hi, std::uint32_t material) {
+  SceneMesh m;
+  m.name = "box";
+  for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+  // quads by corner bits, each listed counter-clockwise seen from outside
+  const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& q : quads) {
+    m.triangles.push_back({q[0], q[1], q[2]});
+    m.triangles.push_back({q[0], q[2], q[3]});
+  }
+  m.materials.assign(m.triangles.size(), material);
+  return m;
+}
+
+// A glass slab 1 unit thick (z in [-0.5, 0.5]), 40 units wide.
+Scene glass_slab(float ior = 1.5f) {
+  Scene s;
+  s.source = "glass slab";
+  s.camera.position = {0, 0, 5};
+  Material glass;
+  glass.name = "glass";
+  glass.diffuse = glm::vec3(0.0f);
+  glass.kt = glm::vec3(1.0f);
+  glass.ior = ior;
+  s.materials = {glass};
+  s.meshes.push_back(box_mesh({-20, -20, -0.5f}, {20, 20, 0.5f}, 0));
+  return s;
+}
+
+Ray make_ray(glm::vec3 o, glm::vec3 d) { return Ray{o.x, o.y, o.z, d.x, d.y, d.z, 0.0f, INFINITY}; }
+glm::dvec3 origin(const TreeRay& r) { return {r.ray.ox, r.ray.oy, r.ray.oz}; }
+glm::dvec3 direction(const TreeRay& r) { return glm::normalize(glm::dvec3(r.ray.dx, r.ray.dy, r.ray.dz)); }
+double fresnel(double cos_i, double eta) {
+  double cos_t = std::sqrt(1.0 - eta * eta * (1.0 - cos_i * cos_i));
+  double rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t), rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+RenderSettings tree_settings(std::uint32_t depth) {
+  RenderSettings s = small(4);
+  s.max_depth = depth;
+  s.min_weight = 0.0f;
+  return s;
+}
+
+TEST(Refraction, RayThroughGlassSlabExitsParallelToItsEntry) {
+  Renderer renderer(test_device(), glass_slab(), accel_names().back());
+  for (double angle : {0.0, 20.0, 45.0, 70.0}) {
+    double a = glm::radians(angle);
+    glm::dvec3 d0(std::sin(a), 0.3 * std::sin(a), -std::cos(a));
+    d0 = glm::normalize(d0);
+    auto tree = renderer.ray_tree(make_ray({0, 0, 3}, glm::vec3(d0)), tree_settings(2));
+    ASSERT_EQ(tree.size(), 3u) << angle;  // the ray, (reflection + inside), (inside's reflection + exit)
+    ASSERT_EQ(tree[1].size(), 2u) << angle;
+    const TreeRay& inside = tree[1][1];
+    EXPECT_LT(origin(inside).z, 0.5);  // started below the entry face
+    // Snell: sin(theta_t) = sin(theta_i) / 1.5, tangential direction preserved
+    double sin_i = std::sqrt(1.0 - d0.z * d0.z), sin_t = std::sqrt(1.0 - direction(inside).z * direction(inside).z);
+    EXPECT_NEAR(sin_t, sin_i / 1.5, 1e-6) << angle;
+    double F = fresnel(std::abs(d0.z), 1.0 / 1.5);
+    EXPECT_NEAR(tree[1][0].path.wr, F, 1e-6) << angle;
+    EXPECT_NEAR(inside.path.wr, 1.0 - F, 1e-6) << angle;
+    // The exit ray: the refraction of the inside ray at z = -0.5.
+    const TreeRay* exit = nullptr;
+    for (const TreeRay& r : tree[2])
+      if (origin(r).z < -0.5 && direction(r).z < 0.0) exit = &r;
+    ASSERT_NE(exit, nullptr) << angle;
+    EXPECT_NEAR(glm::length(direction(*exit) - d0), 0.0, 2e-6) << angle << ": exit not parallel to entry";
+    // ... displaced sideways by the slab (none at normal incidence)
+    EXPECT_NEAR(origin(*exit).z, -0.5, 1e-3);
+  }
+}
+
+TEST(Refraction, TotalInternalReflectionBeyondTheCriticalAngle) {
+  Renderer renderer(test_device(), glass_slab(), accel_names().back());
+  const double critical = glm::degrees(std::asin(1.0 / 1.5));  // 41.81 degrees
+  for (double angle : {critical + 0.5, 60.0, 80.0}) {
+    double a = glm::radians(angle);
+    auto tree = renderer.ray_tree(make_ray({0, 0, 0}, glm::vec3(std::sin(a), 0.0, -std::cos(a))), tree_settings(4));
+    ASSERT_EQ(tree.size(), 5u) << angle;  // trapped: one ray per generation up to the depth limit
+    for (std::size_t g = 1; g < tree.size(); ++g) {
+      ASSERT_EQ(tree[g].size(), 1u) << angle << " generation " << g;
+      EXPECT_NEAR(tree[g][0].path.wr, 1.0, 1e-6) << "all of kt goes to the reflection";
+      EXPECT_NEAR(direction(tree[g][0]).z, (g % 2 ? 1.0 : -1.0) * std::cos(a), 1e-6);
+      EXPECT_LT(std::abs(origin(tree[g][0]).z), 0.5) << "reflected rays stay inside";
+    }
+  }
+  for (double angle : {critical - 0.5, 30.0, 0.0}) {
+    double a = glm::radians(angle);
+    auto tree = renderer.ray_tree(make_ray({0, 0, 0}, glm::vec3(std::sin(a), 0.0, -std::cos(a))), tree_settings(1));
+    ASSERT_EQ(tree.size(), 2u) << angle;
+    ASSERT_EQ(tree[1].size(), 2u) << angle << ": below the critical angle both rays leave";
+    double F = fresnel(std::cos(a), 1.5);
+    EXPECT_NEAR(tree[1][0].path.wr, F, 1e-5) << angle;
+    EXPECT_NEAR(tree[1][1].path.wr, 1.0 - F, 1e-5) << angle;
+    double sin_t = std::min(1.0, 1.5 * std::sin(a));
+    EXPECT_NEAR(std::sqrt(1.0 - direction(tree[1][1]).z * direction(tree[1][1]).z), sin_t, 2e-5) << angle;
+  }
+}
+
+// --- scale and translation ----------------------------------------------------
+
+// The default scene moved far from its scale and from the origin renders the
+// same image: spawn offsets and shadow-ray ends scale with the scene, so
+// there is no acne (dark speckles on lit surfaces) and no lost or spurious
+// shadow: every pixel of a smooth region (walls, floor, shadow interiors)
+// keeps its value. Scaling keeps the geometry's relative precision: only
+// pixels whose centre falls exactly on an edge (the symmetric box's corners)
+// may change. At 1e5 from the origin floats are 0.0078 apart (0.4% of the
+// 2-unit box, 1/4 pixel here) and the spawn offset is 0.036 (about a pixel):
+// edges, grazing shadows and their reflections move by up to two pixels, so
+// pixels within two pixels of an edge may change.
+TEST(Render, ScaledAndTranslatedDefaultSceneRendersTheSameImage) {
+  RenderSettings settings = small(64);
+  Scene base = default_scene();
+  const std::string accel = accel_names().back();
+  Image expected = Renderer(test_device(), base, accel).render(settings);
+  struct Case {
+    const char* what;
+    glm::dmat4 transform;
+    int edge_radius;              // pixels near an edge that may change
+    std::size_t max_pixels_over;  // of 4096, anywhere
+  };
+  const Case cases[] = {
+      {"scaled by 1e-4", glm::scale(glm::dmat4(1.0), glm::dvec3(1e-4)), 1, 41},
+      {"scaled by 1e5", glm::scale(glm::dmat4(1.0), glm::dvec3(1e5)), 1, 41},
+      {"translated by 1e5", glm::translate(glm::dmat4(1.0), glm::dvec3(1e5, -1e5, 1e5)), 2, 410},
+  };
+  for (const Case& c : cases) {
+    Image image = Renderer(test_device(), transform_scene(base, c.transform), accel).render(settings);
+    ImageDifference d = compare_images(image, expected, edge_pixels(expected, 0.05, c.edge_radius));
+    std::printf("[ measure  ] %s: rmse %.5f, max %.4f, over 0.05: %zu of 4096, %zu away from edges (%zu edge "
+                "pixels), max away from edges %.4f\n",
+                c.what, d.rmse, d.max_error, d.pixels_over, d.pixels_over_unmasked, d.masked_pixels,
+                d.max_error_unmasked);
+    EXPECT_EQ(d.pixels_over_unmasked, 0u) << c.what << ": a smooth region changed (acne or a lost shadow)";
+    EXPECT_LE(d.pixels_over, c.max_pixels_over) << c.what;
+  }
+}
+
+// Acne shows best at grazing angles: a lit floor seen at 8 degrees, a sphere
+// on it, a light high above. In every version of the scene, each pixel must
+// be lit or shadowed as in the unmoved scene, but for the one-pixel band
+// around the sphere's silhouette and shadow edge.
+TEST(Render, NoShadowAcneAtGrazingAnglesAtAnyScale) {
+  Scene base;
+  base.source = "grazing floor";
+  base.camera.position = {0.0f, 0.5f, 6.0f};
+  base.camera.look_at = {0.0f, -0.35f, 0.0f};
+  base.camera.fov_deg = 30.0f;
+  base.ambient = glm::vec3(0.1f);
+  Material white;
+  white.name = "white";
+  white.ambient = white.diffuse = glm::vec3(0.8f);
+  white.specular = glm::vec3(0.3f);
+  white.shininess = 20.0f;
+  base.materials = {white};
+  base.lights.push_back(PointLight{{1.0f, 4.0f, -1.0f}, glm::vec3(1.0f), 1.0f});
+  base.meshes.push_back(box_mesh({-30.0f, -1.0f, -30.0f}, {30.0f, 0.0f, 30.0f}, 0));
+  base.spheres.push_back(SceneSphere{{0.0, 0.5, 0.0}, 0.5, 0});
+  RenderSettings settings = small(64);
+  const std::string accel = accel_names().back();
+  Image expected = Renderer(test_device(), base, accel).render(settings);
+  std::vector<std::uint8_t> edges = edge_pixels(expected, 0.05, 1);
+  const glm::dmat4 transforms[] = {glm::scale(glm::dmat4(1.0), glm::dvec3(1e-4)),
+                                   glm::scale(glm::dmat4(1.0), glm::dvec3(1e5)),
+                                   glm::translate(glm::dmat4(1.0), glm::dvec3(-1e5, 1e5, 1e5))};
+  for (const glm::dmat4& t : transforms) {
+    Image image = Renderer(test_device(), transform_scene(base, t), accel).render(settings);
+    ImageDifference d = compare_images(image, expected, edges);
+    EXPECT_EQ(d.pixels_over_unmasked, 0u) << "translation " << t[3][0] << ", scale " << t[0][0];
+    EXPECT_LE(d.max_error_unmasked, 0.01);
+  }
+}
+
+// --- determinism, knobs, specialisation -----------------------------------------
+
+TEST(Render, DeterministicAndIndependentOfBatchSize) {
+  Scene scene = default_scene();
+  Renderer renderer(test_device(), scene, accel_names().front());
+  RenderSettings s = small(40, 2);
+  Image a = renderer.render(s);
+  Image b = renderer.render(s);
+  s.batch_pixels = 333;  // batches that split tiles and rows
+  Image c = renderer.render(s);
+  EXPECT_EQ(a.rgb, b.rgb);
+  EXPECT_EQ(a.rgb, c.rgb);
+}
+
+TEST(Render, DepthAndWeightThresholdTradeRaysForAccuracy) {
+  Scene scene = default_scene();
+  Renderer renderer(test_device(), scene, accel_names().back());
+  RenderSettings s = small(48);
+  s.min_weight = 0.0f;
+  Image full = renderer.render(s);
+  RayCounts full_rays = renderer.stats().rays;
+  EXPECT_GT(full_rays.reflection, 0u);
+  EXPECT_GT(full_rays.refraction, 0u);
+  EXPECT_EQ(full_rays.camera, 48u * 48u);
+
+  s.min_weight = 0.2f;
+  Image pruned = renderer.render(s);
+  RayCounts pruned_rays = renderer.stats().rays;
+  EXPECT_LT(pruned_rays.reflection + pruned_rays.refraction, full_rays.reflection + full_rays.refraction);
+  ImageDifference d = compare_images(pruned, full);
+  EXPECT_GT(d.max_error, 0.0);
+  EXPECT_LT(d.rmse, 0.05) << "dropping weak rays loses little";
+
+  s.max_depth = 0;
+  s.min_weight = 0.0f;
+  renderer.render(s);
+  EXPECT_EQ(renderer.stats().rays.reflection + renderer.stats().rays.refraction, 0u);
+  EXPECT_GT(renderer.stats().rays.shadow, 0u);
+}
+
+TEST(Render, KernelsAreSpecialisedToTheScene) {
+  auto has = [](const std::vector<std::string>& defines, const std::string& d) {
+    return std::find(defines.begin(), defines.end(), d) != defines.end();
+  };
+  Renderer full(test_device(), default_scene(), "brute");
+  EXPECT_TRUE(has(full.defines(), "RTCL_HAS_SPHERES"));
+  EXPECT_TRUE(has(full.defines(), "RTCL_HAS_REFRACTION"));
+  EXPECT_TRUE(has(full.defines(), "RTCL_HAS_REFLECTION"));
+  EXPECT_TRUE(has(full.defines(), "RTCL_LIGHT_COUNT=1"));
+
+  // Only opaque diffuse triangles: no sphere, reflection or refraction code.
+  Scene plain = default_scene();
+  plain.spheres.clear();
+  plain.meshes.resize(1);  // the room, no glass block
+  for (Material& m : plain.materials) m.kr = m.kt = glm::vec3(0.0f);
+  plain.lights.push_back(PointLight{{-0.5f, 1.5f, 0.5f}, {0.3f, 0.3f, 1.0f}, 0.5f});
+  Renderer renderer(test_device(), plain, "brute");
+  EXPECT_FALSE(has(renderer.defines(), "RTCL_HAS_SPHERES"));
+  EXPECT_FALSE(has(renderer.defines(), "RTCL_HAS_REFRACTION"));
+  EXPECT_FALSE(has(renderer.defines(), "RTCL_HAS_REFLECTION"));
+  EXPECT_TRUE(has(renderer.defines(), "RTCL_LIGHT_COUNT=2"));
+  RenderSettings s = small(32);
+  ReferenceImage ref = reference_render(plain, s);
+  ImageDifference d = compare_images(renderer.render(s), ref.image, ref.ambiguous);
+  EXPECT_LE(d.max_error_unmasked, max_unambiguous_error);
+  EXPECT_EQ(renderer.stats().rays.reflection, 0u);
+}
+
+TEST(Render, TileOrderVisitsEveryPixelOnceInCoherentPackets) {
+  for (auto [w, h] : {std::pair{13u, 7u}, std::pair{8u, 8u}, std::pair{1u, 17u}, std::pair{64u, 33u}}) {
+    std::vector<int> seen(w * h, 0);
+    for (std::uint32_t i = 0; i < w * h; ++i) {
+      std::uint32_t p = rtcl_tile_order_pixel(i, w, h);
+      ASSERT_LT(p, w * h);
+      ++seen[p];
+    }
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), int(w * h)) << w << "x" << h;
+  }
+  // In the interior of an image, a packet of 8 consecutive rays is one tile row.
+  for (std::uint32_t i = 0; i < 64; i += 8) {
+    std::uint32_t p0 = rtcl_tile_order_pixel(i, 64, 64);
+    for (std::uint32_t k = 1; k < 8; ++k) EXPECT_EQ(rtcl_tile_order_pixel(i + k, 64, 64), p0 + k);
+  }
+}
+
+TEST(Render, BadSettingsAreClearErrors) {
+  Renderer renderer(test_device(), default_scene(), "brute");
+  RenderSettings s = small(8);
+  s.spp = 0;
+  EXPECT_THROW(renderer.render(s), Error);
+  s = small(8);
+  s.width = 0;
+  EXPECT_THROW(renderer.render(s), Error);
+  s = small(8);
+  s.min_weight = -1.0f;
+  EXPECT_THROW(renderer.render(s), Error);
+  EXPECT_THROW(Renderer(test_device(), default_scene(), "no-such-accel"), Error);
+}
+
+// --- images -------------------------------------------------------------------
+
+TEST(Image, ExrKeepsLinearFloatsPngIsSrgb) {
+  TempDir dir;
+  Image image;
+  image.width = 2;
+  image.height = 1;
+  image.rgb = {0.0f, 0.5f, 3.25f, 0.2f, 1.0f, 0.01f};
+  write_image(dir.file("a.exr"), image);
+  Image exr = read_image(dir.file("a.exr"));
+  EXPECT_EQ(exr.rgb, image.rgb);
+  write_image(dir.file("a.png"), image);
+  Image png = read_image(dir.file("a.png"));
+  ASSERT_EQ(png.rgb.size(), 6u);
+  EXPECT_NEAR(png.rgb[1], 0.5f, 0.005f) << "sRGB-encoded 8-bit, decoded back";
+  EXPECT_FLOAT_EQ(png.rgb[2], 1.0f) << "clamped";
+  EXPECT_NEAR(png.rgb[5], 0.01f, 0.001f);
+  EXPECT_THROW(write_image(dir.file("a.nosuchformat"), image), Error);
+  EXPECT_THROW(write_image(dir.file("missing/dir/a.png"), image), Error);
+  EXPECT_EQ(dir.entries(), (std::vector<std::string>{"a.exr", "a.png"})) << "no temporary files left";
+}
+
+// --- the command --------------------------------------------------------------
+
+struct CommandRun {
+  int status = -1;
+  std::string out, err;
+};
+
+CommandRun rtcl(const TempDir& dir, const std::string& args) {
+  std::string command = "cd '" + dir.path() + "' && '" + RTCL_BINARY_DIR + "/rtcl' " + args + " >" + dir.file(".out") +
+                        " 2>" + dir.file(".err");
+  int raw = std::system(command.c_str());
+  CommandRun r{WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, read_text(dir.file(".out")), read_text(dir.file(".err"))};
+  std::remove(dir.file(".out").c_str());
+  std::remove(dir.file(".err").c_str());
+  return r;
+}
+
+TEST(RenderCommand, RendersTheDefaultSceneAndSummarises) {
+  TempDir dir;
+  CommandRun r = rtcl(dir, "render --width 24 --height 16 --depth 3 --spp 2 --accel brute -o out.exr");
+  ASSERT_EQ(r.status, 0) << r.err;
+  Image image = read_image(dir.file("out.exr"));
+  EXPECT_EQ(image.width, 24u);
+  EXPECT_EQ(image.height, 16u);
+  EXPECT_NE(r.out.find("camera"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("shadow"), std::string::npos);
+  EXPECT_NE(r.out.find("refraction"), std::string::npos);
+  EXPECT_NE(r.out.find("Mrays/s"), std::string::npos);
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << "no progress bar when stderr is not a terminal";
+}
+
+TEST(RenderCommand, FailuresExitNonZeroAndLeaveNoImage) {
+  TempDir dir;
+  dir.write("bad.json", "{\"camera\": {\"position\": [0, 0, 5], \"look_at\": [0, 0, 0]}, \"objects\": [}");
+  CommandRun r = rtcl(dir, "render bad.json -o out.png --width 8");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("rtcl: error: bad.json: malformed JSON"), std::string::npos) << r.err;
+
+  dir.write("old.png", "previous content");
+  r = rtcl(dir, "render missing.json -o old.png --width 8");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(read_text(dir.file("old.png")), "previous content") << "a failed render keeps the old file";
+
+  r = rtcl(dir, "render -o out.unknownformat --width 8");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("out.unknownformat"), std::string::npos) << r.err;
+  r = rtcl(dir, "render -o out.png --width 8 --accel nonsense");
+  EXPECT_NE(r.status, 0);
+  std::vector<std::string> entries = dir.entries();
+  EXPECT_EQ(entries, (std::vector<std::string>{"bad.json", "old.png"})) << "no image and no temporary file";
+}
+
+}  // namespace
+}  // namespace rtcl::test

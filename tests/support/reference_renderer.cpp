@@ -1,0 +1,261 @@
+#include "support/reference_renderer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "rtcl/render/camera.hpp"
+#include "rtcl/render/render_layouts.hpp"
+
+namespace rtcl::test {
+
+namespace {
+
+using glm::dvec3;
+
+// The same rule as RTCL_SHADOW_SHORTEN in kernels/render/shade.cl: a
+// semantic choice (a light on a surface lights it), not a precision fix.
+constexpr double shadow_shorten = 1e-4;
+// The reference's own spawn offset, relative to the magnitudes involved: far
+// above double rounding, far below the device's float offset.
+constexpr double spawn_offset = 1e-9;
+
+double max3(const dvec3& v) { return std::max(v.x, std::max(v.y, v.z)); }
+double max_abs3(const dvec3& v) { return max3(glm::abs(v)); }
+
+struct RefHit {
+  double t = std::numeric_limits<double>::infinity();
+  int prim = -1;
+  double u = 0.0, v = 0.0;
+};
+
+class Tracer {
+ public:
+  Tracer(const Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {
+    FlatScene flat = flatten(scene);
+    material_ = flat.material;
+    const Geometry& g = flat.geometry;
+    for (std::size_t t = 0; t < g.triangles.size(); ++t) {
+      Tri tri;
+      for (int k = 0; k < 3; ++k) tri.v[k] = dvec3(g.vertices[g.triangles[t][k]]);
+      tri.skip = zero_area(g, t);  // no structure stores zero-area triangles
+      triangles_.push_back(tri);
+    }
+    for (const Sphere& s : g.spheres) spheres_.push_back({dvec3(s.center), double(s.radius)});
+  }
+
+  // Radiance along the unit direction d from o; `signature` mixes in every
+  // decision the ray tree makes.
+  dvec3 trace(const dvec3& o, const dvec3& d, const dvec3& w, std::uint32_t depth, std::uint64_t& signature) const {
+    RefHit h = closest(o, d, std::numeric_limits<double>::infinity(), false);
+    mix(signature, static_cast<std::uint64_t>(h.prim + 1));
+    if (h.prim < 0) return w * dvec3(scene_.background);
+
+    // Surface point rebuilt from the primitive, geometric normal.
+    dvec3 p, ng;
+    double extent;
+    if (static_cast<std::size_t>(h.prim) < triangles_.size()) {
+      const Tri& t = triangles_[h.prim];
+      dvec3 e1 = t.v[1] - t.v[0], e2 = t.v[2] - t.v[0];
+      p = t.v[0] + h.u * e1 + h.v * e2;
+      ng = glm::normalize(glm::cross(e1, e2));
+      extent = std::max(max_abs3(e1), max_abs3(e2));
+    } else {
+      const Ball& s = spheres_[h.prim - triangles_.size()];
+      ng = glm::normalize(o + h.t * d - s.center);
+      p = s.center + s.radius * ng;
+      extent = s.radius;
+    }
+    const Material& m = scene_.materials[material_[h.prim]];
+    double offset = spawn_offset * (max_abs3(p) + extent);
+    double cos_i = -glm::dot(d, ng);
+    bool front = cos_i > 0.0;
+    dvec3 n = front ? ng : -ng;
+    cos_i = std::abs(cos_i);
+    dvec3 above = p + offset * n;
+    dvec3 radiance = w * (dvec3(m.emission) + dvec3(scene_.ambient) * dvec3(m.ambient));
+
+    for (const PointLight& light : scene_.lights) {
+      dvec3 ld = glm::normalize(dvec3(light.position) - p);
+      double cos_l = glm::dot(n, ld);
+      if (!(cos_l > 0.0)) continue;
+      dvec3 f = dvec3(m.diffuse) * cos_l;
+      if (max3(dvec3(m.specular)) > 0.0) {
+        dvec3 mirror = 2.0 * cos_l * n - ld;
+        double rv = std::max(glm::dot(mirror, -d), 0.0);
+        f += dvec3(m.specular) * (m.shininess > 0.0f ? std::pow(rv, double(m.shininess)) : 1.0);
+      }
+      dvec3 c = w * dvec3(light.color) * double(light.intensity) * f;
+      if (!(max3(c) > 0.0)) continue;
+      bool occluded = closest(above, dvec3(light.position) - above, 1.0 - shadow_shorten, true).prim >= 0;
+      mix(signature, occluded ? 0x51u : 0x52u);
+      if (!occluded) radiance += c;
+    }
+
+    if (depth >= settings_.max_depth || (!m.reflective() && !m.transmissive())) return radiance;
+    const double min_weight = settings_.min_weight;
+    dvec3 wr = w * dvec3(m.kr);
+    if (m.transmissive()) {
+      double eta = front ? 1.0 / m.ior : double(m.ior);
+      double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+      double F = 1.0;
+      if (sin2_t < 1.0) {
+        double cos_t = std::sqrt(1.0 - sin2_t);
+        double rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+        double rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+        F = 0.5 * (rs * rs + rp * rp);
+        dvec3 wt = w * dvec3(m.kt) * (1.0 - F);
+        if (max3(wt) > 0.0 && max3(wt) >= min_weight) {
+          dvec3 td = glm::normalize(eta * d + (eta * cos_i - cos_t) * n);
+          radiance += trace(p - offset * n, td, wt, depth + 1, signature);
+        }
+      }
+      wr += w * dvec3(m.kt) * F;
+    }
+    if (max3(wr) > 0.0 && max3(wr) >= min_weight) radiance += trace(above, d + 2.0 * cos_i * n, wr, depth + 1, signature);
+    return radiance;
+  }
+
+ private:
+  struct Tri {
+    dvec3 v[3];
+    bool skip = false;
+  };
+  struct Ball {
+    dvec3 center;
+    double radius;
+  };
+
+  static void mix(std::uint64_t& s, std::uint64_t value) {
+    s ^= value + 0x9e3779b97f4a7c15ull + (s << 6) + (s >> 2);
+  }
+
+  // Nearest hit with 0 <= t <= tmax (t in units of |d|); any: the first found.
+  RefHit closest(const dvec3& o, const dvec3& d, double tmax, bool any) const {
+    RefHit best;
+    best.t = tmax;
+    for (std::size_t i = 0; i < triangles_.size(); ++i) {
+      const Tri& tri = triangles_[i];
+      if (tri.skip) continue;
+      // Möller-Trumbore in double.
+      dvec3 e1 = tri.v[1] - tri.v[0], e2 = tri.v[2] - tri.v[0];
+      dvec3 pv = glm::cross(d, e2);
+      double det = glm::dot(e1, pv);
+      if (det == 0.0) continue;
+      dvec3 tv = o - tri.v[0];
+      double u = glm::dot(tv, pv) / det;
+      if (u < 0.0 || u > 1.0) continue;
+      dvec3 qv = glm::cross(tv, e1);
+      double v = glm::dot(d, qv) / det;
+      if (v < 0.0 || u + v > 1.0) continue;
+      double t = glm::dot(e2, qv) / det;
+      if (t < 0.0 || t > best.t) continue;
+      best = RefHit{t, static_cast<int>(i), u, v};
+      if (any) return best;
+    }
+    double a = glm::dot(d, d);
+    for (std::size_t i = 0; i < spheres_.size(); ++i) {
+      const Ball& s = spheres_[i];
+      dvec3 f = o - s.center;
+      double b = -glm::dot(f, d);
+      dvec3 l = f + (b / a) * d;
+      double disc = a * (s.radius * s.radius - glm::dot(l, l));
+      if (disc < 0.0) continue;
+      double q = b + std::copysign(std::sqrt(disc), b);
+      double c = glm::dot(f, f) - s.radius * s.radius;
+      double t0 = c / q, t1 = q / a;
+      for (double t : {std::min(t0, t1), std::max(t0, t1)}) {
+        if (t < 0.0 || t > best.t) continue;
+        best = RefHit{t, static_cast<int>(triangles_.size() + i), 0.0, 0.0};
+        if (any) return best;
+        break;
+      }
+    }
+    if (best.prim < 0) best.t = std::numeric_limits<double>::infinity();
+    return best;
+  }
+
+  const Scene& scene_;
+  RenderSettings settings_;
+  std::vector<std::uint32_t> material_;
+  std::vector<Tri> triangles_;
+  std::vector<Ball> spheres_;
+};
+
+}  // namespace
+
+ReferenceImage reference_render(const Scene& scene, const RenderSettings& settings, double ambiguity_px) {
+  Tracer tracer(scene, settings);
+  CameraFrame frame = camera_frame(scene.camera, settings.width, settings.height);
+  ReferenceImage out;
+  out.image.width = settings.width;
+  out.image.height = settings.height;
+  std::size_t pixels = std::size_t(settings.width) * settings.height;
+  out.image.rgb.assign(pixels * 3, 0.0f);
+  out.ambiguous.assign(pixels, 0);
+  const double offsets[5][2] = {{0, 0}, {-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+  for (std::uint32_t y = 0; y < settings.height; ++y)
+    for (std::uint32_t x = 0; x < settings.width; ++x) {
+      std::uint32_t pixel = y * settings.width + x;
+      dvec3 sum(0.0);
+      for (std::uint32_t sample = 0; sample < settings.spp; ++sample) {
+        float jx, jy;
+        rtcl_sample_position(pixel, sample, settings.spp, &jx, &jy);
+        std::uint64_t signature[5] = {};
+        for (int k = 0; k < 5; ++k) {
+          double fx = x + double(jx) + offsets[k][0] * ambiguity_px;
+          double fy = y + double(jy) + offsets[k][1] * ambiguity_px;
+          dvec3 d = glm::normalize(frame.corner + fx * frame.du + fy * frame.dv);
+          dvec3 radiance = tracer.trace(frame.origin, d, dvec3(1.0), 0, signature[k]);
+          if (k == 0) sum += radiance;
+          if (signature[k] != signature[0]) out.ambiguous[pixel] = 1;
+        }
+      }
+      for (int c = 0; c < 3; ++c) out.image.rgb[pixel * 3 + c] = static_cast<float>(sum[c] / settings.spp);
+    }
+  return out;
+}
+
+ImageDifference compare_images(const Image& a, const Image& b, const std::vector<std::uint8_t>& mask,
+                               double over) {
+  if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size())
+    throw std::invalid_argument("compare_images: sizes differ");
+  ImageDifference d;
+  double sq = 0.0;
+  std::size_t pixels = std::size_t(a.width) * a.height;
+  for (std::size_t p = 0; p < pixels; ++p) {
+    bool masked = !mask.empty() && mask[p];
+    d.masked_pixels += masked;
+    double worst = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      double e = std::abs(double(a.rgb[p * 3 + c]) - double(b.rgb[p * 3 + c]));
+      if (std::isnan(e)) e = std::numeric_limits<double>::infinity();
+      sq += e * e;
+      worst = std::max(worst, e);
+    }
+    d.max_error = std::max(d.max_error, worst);
+    if (!masked) d.max_error_unmasked = std::max(d.max_error_unmasked, worst);
+    d.pixels_over += worst > over;
+    d.pixels_over_unmasked += worst > over && !masked;
+  }
+  d.rmse = std::sqrt(sq / (3.0 * pixels));
+  return d;
+}
+
+std::vector<std::uint8_t> edge_pixels(const Image& image, double step, int radius) {
+  std::vector<std::uint8_t> edge(std::size_t(image.width) * image.height, 0);
+  for (std::uint32_t y = 0; y < image.height; ++y)
+    for (std::uint32_t x = 0; x < image.width; ++x)
+      for (int dy = -radius; dy <= radius; ++dy)
+        for (int dx = -radius; dx <= radius; ++dx) {
+          long nx = long(x) + dx, ny = long(y) + dy;
+          if (nx < 0 || ny < 0 || nx >= long(image.width) || ny >= long(image.height)) continue;
+          for (int c = 0; c < 3; ++c)
+            if (std::abs(image.at(x, y, c) - image.at(std::uint32_t(nx), std::uint32_t(ny), c)) > step)
+              edge[std::size_t(y) * image.width + x] = 1;
+        }
+  return edge;
+}
+
+}  // namespace rtcl::test
