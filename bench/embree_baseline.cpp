@@ -1,0 +1,179 @@
+#include "embree_baseline.hpp"
+
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "bench_scenes.hpp"
+#include "rtcl/error.hpp"
+
+namespace rtcl::bench {
+
+namespace {
+
+// Bytes Embree holds right now, from its memory monitor (allocations are
+// reported positive, frees negative).
+std::atomic<long long> embree_live_bytes{0};
+
+bool monitor_memory(void*, ssize_t bytes, bool) {
+  embree_live_bytes += bytes;
+  return true;
+}
+
+// One Embree device per process; its TBB arena gets host_threads() threads.
+RTCDevice embree_device() {
+  static RTCDevice device = [] {
+    std::string config = "threads=" + std::to_string(host_threads());
+    RTCDevice d = rtcNewDevice(config.c_str());
+    if (!d) throw Error("Embree: rtcNewDevice(\"" + config + "\") failed (error " +
+                        std::to_string(rtcGetDeviceError(nullptr)) + ")");
+    rtcSetDeviceMemoryMonitorFunction(d, monitor_memory, nullptr);
+    return d;
+  }();
+  return device;
+}
+
+void check_embree(const char* what) {
+  RTCError error = rtcGetDeviceError(embree_device());
+  if (error != RTC_ERROR_NONE) throw Error(std::string("Embree: ") + what + " failed (RTCError " + std::to_string(error) + ")");
+}
+
+constexpr std::size_t block_rays = 1024;  // rays a thread takes from the shared counter at once
+
+void closest(RTCScene scene, const Ray* rays, Hit* hits, std::size_t begin, std::size_t end) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  for (std::size_t i = begin; i < end; ++i) {
+    const Ray& r = rays[i];
+    RTCRayHit rh;
+    rh.ray.org_x = r.ox, rh.ray.org_y = r.oy, rh.ray.org_z = r.oz;
+    rh.ray.dir_x = r.dx, rh.ray.dir_y = r.dy, rh.ray.dir_z = r.dz;
+    rh.ray.tnear = r.tmin;
+    rh.ray.tfar = r.tmax;
+    rh.ray.time = 0.0f;
+    rh.ray.mask = ~0u;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &context, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+      hits[i] = Hit{std::numeric_limits<float>::infinity(), 0.0f, 0.0f, -1};
+    else
+      hits[i] = Hit{rh.ray.tfar, rh.hit.u, rh.hit.v, static_cast<rtcl_i32>(rh.hit.primID)};
+  }
+}
+
+void occluded(RTCScene scene, const Ray* rays, Hit* hits, std::size_t begin, std::size_t end) {
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  for (std::size_t i = begin; i < end; ++i) {
+    const Ray& r = rays[i];
+    RTCRay ray;
+    ray.org_x = r.ox, ray.org_y = r.oy, ray.org_z = r.oz;
+    ray.dir_x = r.dx, ray.dir_y = r.dy, ray.dir_z = r.dz;
+    ray.tnear = r.tmin;
+    ray.tfar = r.tmax;
+    ray.time = 0.0f;
+    ray.mask = ~0u;
+    ray.id = 0;
+    ray.flags = 0;
+    rtcOccluded1(scene, &context, &ray);
+    // rtcOccluded1 sets tfar = -inf when the ray is blocked.
+    if (ray.tfar == -std::numeric_limits<float>::infinity())
+      hits[i] = Hit{r.tmin, 0.0f, 0.0f, 0};
+    else
+      hits[i] = Hit{std::numeric_limits<float>::infinity(), 0.0f, 0.0f, -1};
+  }
+}
+
+}  // namespace
+
+// Embree reads vertices with 16-byte loads: the vertex array carries one
+// float of padding after the last vertex.
+struct EmbreeScene::Buffers {
+  std::vector<float> vertices;
+  std::vector<std::uint32_t> indices;
+};
+
+EmbreeScene::EmbreeScene(const Geometry& geometry, EmbreeQuality quality) : buffers_(new Buffers) {
+  try {
+    build(geometry, quality);
+  } catch (...) {
+    release();
+    throw;
+  }
+}
+
+void EmbreeScene::build(const Geometry& geometry, EmbreeQuality quality) {
+  RTCDevice device = embree_device();
+  buffers_->vertices.reserve(3 * geometry.vertices.size() + 1);
+  for (const glm::vec3& v : geometry.vertices) buffers_->vertices.insert(buffers_->vertices.end(), {v.x, v.y, v.z});
+  buffers_->vertices.push_back(0.0f);
+  buffers_->indices.reserve(3 * geometry.triangles.size());
+  for (const glm::uvec3& t : geometry.triangles) buffers_->indices.insert(buffers_->indices.end(), {t.x, t.y, t.z});
+
+  long long bytes_before = embree_live_bytes.load();
+  auto start = std::chrono::steady_clock::now();
+  RTCScene scene = rtcNewScene(device);
+  check_embree("rtcNewScene");
+  scene_ = scene;
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
+  rtcSetSceneBuildQuality(scene, quality == EmbreeQuality::high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+  RTCGeometry mesh = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  rtcSetSharedGeometryBuffer(mesh, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, buffers_->vertices.data(), 0,
+                             3 * sizeof(float), geometry.vertices.size());
+  rtcSetSharedGeometryBuffer(mesh, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, buffers_->indices.data(), 0,
+                             3 * sizeof(std::uint32_t), geometry.triangles.size());
+  if (quality == EmbreeQuality::high) rtcSetGeometryBuildQuality(mesh, RTC_BUILD_QUALITY_HIGH);
+  rtcCommitGeometry(mesh);
+  rtcAttachGeometry(scene, mesh);
+  rtcReleaseGeometry(mesh);
+  rtcCommitScene(scene);
+  auto stop = std::chrono::steady_clock::now();
+  check_embree("building the scene");
+  build_ms_ = std::chrono::duration<double, std::milli>(stop - start).count();
+  bytes_ = static_cast<std::size_t>(std::max(0LL, embree_live_bytes.load() - bytes_before));
+}
+
+EmbreeScene::~EmbreeScene() { release(); }
+
+void EmbreeScene::release() {
+  if (scene_) rtcReleaseScene(static_cast<RTCScene>(scene_));
+  scene_ = nullptr;
+  delete buffers_;
+  buffers_ = nullptr;
+}
+
+void EmbreeScene::trace(Query query, const Ray* rays, Hit* hits, std::size_t count, unsigned threads) const {
+  RTCScene scene = static_cast<RTCScene>(scene_);
+  auto kernel = query == Query::closest ? closest : occluded;
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (;;) {
+      std::size_t begin = next.fetch_add(block_rays);
+      if (begin >= count) return;
+      kernel(scene, rays, hits, begin, std::min(count, begin + block_rays));
+    }
+  };
+  std::vector<std::thread> helpers;
+  for (unsigned t = 1; t < std::max(threads, 1u); ++t) helpers.emplace_back(work);
+  work();
+  for (auto& h : helpers) h.join();
+}
+
+std::string embree_version() {
+  RTCDevice device = embree_device();
+  return std::to_string(rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_VERSION_MAJOR)) + "." +
+         std::to_string(rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_VERSION_MINOR)) + "." +
+         std::to_string(rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_VERSION_PATCH));
+}
+
+}  // namespace rtcl::bench

@@ -1,0 +1,55 @@
+// Embree 3 as the yardstick: the same triangles in one Embree scene, traced
+// one ray at a time (rtcIntersect1 / rtcOccluded1) by host threads over our
+// Ray records, answering into our Hit records. Built only when CMake finds
+// Embree 3 (RTCL_BENCH_HAVE_EMBREE).
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/layouts.hpp"
+#include "rtcl/scene/geometry.hpp"
+
+namespace rtcl::bench {
+
+enum class EmbreeQuality {
+  standard,  // RTC_BUILD_QUALITY_MEDIUM, Embree's default: binned SAH
+  high,      // RTC_BUILD_QUALITY_HIGH: SAH with spatial splits, slower build
+};
+
+class EmbreeScene {
+ public:
+  // Builds a scene (RTC_SCENE_FLAG_NONE) with one triangle mesh; primID is the
+  // triangle index. Throws Error with Embree's error code on failure.
+  EmbreeScene(const Geometry& geometry, EmbreeQuality quality);
+  ~EmbreeScene();
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+  // Wall-clock ms of geometry setup + rtcCommitScene (Embree builds with TBB).
+  double build_ms() const { return build_ms_; }
+  // Bytes Embree allocated for the scene and kept after the build (its memory
+  // monitor); the vertex and index arrays are shared with us, not counted.
+  std::size_t bytes() const { return bytes_; }
+
+  // Answers rays[0 .. count) into hits[0 .. count) on `threads` host threads
+  // taking blocks of rays from a shared counter. Query::closest: t, u, v, prim
+  // of the nearest hit (u, v as in Hit). Query::any: Embree reports no hit
+  // data, so an occluded ray gets t = tmin, prim = 0, u = v = 0. Misses as Hit.
+  void trace(Query query, const Ray* rays, Hit* hits, std::size_t count, unsigned threads) const;
+
+ private:
+  void build(const Geometry& geometry, EmbreeQuality quality);
+  void release();
+  struct Buffers;
+  void* scene_ = nullptr;  // RTCScene
+  Buffers* buffers_ = nullptr;
+  double build_ms_ = 0.0;
+  std::size_t bytes_ = 0;
+};
+
+// The library version, e.g. "3.13.5".
+std::string embree_version();
+
+}  // namespace rtcl::bench

@@ -1,0 +1,169 @@
+// rtcl's structures on the OpenCL device:
+//   build/<scene>/<accel>          host build + flatten time (stats().build_ms)
+//   trace/<scene>/<kind>/<accel>   kernel time of one launch over the ray set
+// Kernel time comes from OpenCL event profiling (COMMAND_START .. COMMAND_END)
+// and is reported as manual time; a warm-up launch first absorbs PoCL's
+// compile-on-first-launch. Brute force traces a subset (brute_ray_limit()).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "bench_scenes.hpp"
+#include "rtcl/accel/accel.hpp"
+
+namespace rtcl::bench {
+namespace {
+
+// Device-side state for the resident scene: built structures and uploaded
+// ray sets, released when a benchmark for another scene starts.
+class DeviceScene {
+ public:
+  struct Rays {
+    const RaySet* host = nullptr;  // what was uploaded: the scene's set or `subset`
+    RaySet subset;
+    cl::Buffer rays, hits;
+  };
+
+  static DeviceScene& get(const std::shared_ptr<const BenchScene>& scene) {
+    static std::unique_ptr<DeviceScene> resident;
+    if (!resident || resident->scene_ != scene) {
+      resident.reset();
+      resident.reset(new DeviceScene(scene));
+    }
+    return *resident;
+  }
+
+  const Accel& accel(const std::string& name) {
+    auto& slot = accels_[name];
+    if (!slot) slot = make_accel(bench_device(), name, scene_->geometry);
+    return *slot;
+  }
+
+  // Once per structure and ray set (not per repetition): a launch of the same
+  // size as the timed ones, since PoCL generates code at the first launch of
+  // each work-group size, checked against the reference so that a wrong
+  // structure cannot look fast. Returns agreement() of that launch.
+  double warm_up(const Accel& accel, RayKind kind, const Rays& rays) {
+    auto key = std::make_pair(accel.name(), kind);
+    if (auto it = agreement_.find(key); it != agreement_.end()) return it->second;
+    std::size_t count = rays.host->rays.size();
+    Query query = ray_kind_query(kind);
+    accel.trace(query, rays.rays, rays.hits, count).wait();
+    std::vector<Hit> hits(count);
+    bench_device().queue().enqueueReadBuffer(rays.hits, CL_TRUE, 0, count * sizeof(Hit), hits.data());
+    return agreement_[key] = agreement(hits, *rays.host, query);
+  }
+
+  // The ray set for `kind`, limited to `limit` rays (0: all).
+  const Rays& rays(RayKind kind, std::size_t limit) {
+    auto key = std::make_pair(kind, limit);
+    if (auto it = rays_.find(key); it != rays_.end() && it->second.hits() != nullptr) return it->second;
+    Rays& r = rays_[key];  // filled in place: host may point at r.subset
+    if (limit) {
+      r.subset = subset(scene_->rays(kind), limit);
+      r.host = &r.subset;
+    } else {
+      r.host = &scene_->rays(kind);
+    }
+    const Device& device = bench_device();
+    std::size_t count = r.host->rays.size();
+    r.rays = device.upload(r.host->rays.data(), count * sizeof(Ray), "benchmark rays");
+    r.hits = device.allocate(count * sizeof(Hit), "benchmark hits");
+    return r;
+  }
+
+ private:
+  explicit DeviceScene(std::shared_ptr<const BenchScene> scene) : scene_(std::move(scene)) {}
+  std::shared_ptr<const BenchScene> scene_;
+  std::map<std::string, std::unique_ptr<Accel>> accels_;
+  std::map<std::pair<RayKind, std::size_t>, Rays> rays_;
+  std::map<std::pair<std::string, RayKind>, double> agreement_;
+};
+
+// Seconds between the kernel's start and end on the device.
+double kernel_seconds(const cl::Event& event) {
+  auto start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+  auto end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+  return static_cast<double>(end - start) * 1e-9;
+}
+
+double bytes_per_triangle(const AccelStats& stats, std::size_t triangles) {
+  return triangles ? static_cast<double>(stats.device_bytes) / static_cast<double>(triangles) : 0.0;
+}
+
+void trace_benchmark(benchmark::State& state, const std::string& scene_name, RayKind kind,
+                     const std::string& accel_name) {
+  try {
+    auto scene = bench_scene(scene_name);
+    DeviceScene& device_scene = DeviceScene::get(scene);
+    const Accel& accel = device_scene.accel(accel_name);
+    std::size_t limit = accel_name == "brute" ? brute_ray_limit() : 0;
+    const DeviceScene::Rays& rays = device_scene.rays(kind, limit);
+    std::size_t count = rays.host->rays.size();
+    Query query = ray_kind_query(kind);
+
+    double agree = device_scene.warm_up(accel, kind, rays);
+
+    for (auto _ : state) {
+      cl::Event done = accel.trace(query, rays.rays, rays.hits, count);
+      done.wait();
+      state.SetIterationTime(kernel_seconds(done));
+    }
+    state.counters["rays"] = benchmark::Counter(static_cast<double>(count), benchmark::Counter::kIsIterationInvariantRate);
+    state.counters["ray_count"] = static_cast<double>(count);
+    state.counters["hit_fraction"] = rays.host->hit_fraction();
+    state.counters["agree"] = agree;
+    state.counters["bytes_per_tri"] = bytes_per_triangle(accel.stats(), scene->triangle_count());
+    state.counters["build_ms"] = accel.stats().build_ms;
+    state.SetLabel(accel.device().info().name);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+  }
+}
+
+void build_benchmark(benchmark::State& state, const std::string& scene_name, const std::string& accel_name) {
+  try {
+    auto scene = bench_scene(scene_name);
+    const Device& device = bench_device();
+    static std::set<std::string> compiled;  // the first make_accel also builds the trace program
+    if (compiled.insert(accel_name).second) make_accel(device, accel_name, scene->geometry);
+    AccelStats stats;
+    double total_ms = 0.0;
+    for (auto _ : state) {
+      auto accel = make_accel(device, accel_name, scene->geometry);
+      stats = accel->stats();
+      total_ms += stats.build_ms;
+      state.SetIterationTime(stats.build_ms * 1e-3);
+    }
+    state.counters["build_ms"] = total_ms / static_cast<double>(std::max<benchmark::IterationCount>(1, state.iterations()));
+    state.counters["bytes_per_tri"] = bytes_per_triangle(stats, scene->triangle_count());
+    state.counters["triangles"] = static_cast<double>(scene->triangle_count());
+    state.counters["nodes"] = static_cast<double>(stats.node_count);
+    state.counters["leaves"] = static_cast<double>(stats.leaf_count);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+  }
+}
+
+[[maybe_unused]] const bool registered = add_scene_hook([](const SceneSpec& spec) {
+  const std::vector<std::string> names = accel_names();
+  for (const std::string& accel : names)
+    benchmark::RegisterBenchmark(("build/" + spec.name + "/" + accel).c_str(), build_benchmark, spec.name, accel)
+        ->UseManualTime()
+        ->Unit(benchmark::kMillisecond);
+  for (RayKind kind : ray_kinds)
+    for (const std::string& accel : names)
+      benchmark::RegisterBenchmark(
+          ("trace/" + spec.name + "/" + ray_kind_name(kind) + "/" + accel).c_str(), trace_benchmark, spec.name,
+          kind, accel)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond);
+});
+
+}  // namespace
+}  // namespace rtcl::bench
