@@ -371,7 +371,10 @@ TEST(Adversarial, RaysInThePlaneOfAFaceHitOnlyTheEdgeAhead) {
     float dz = i < 100 ? 0.0f : slope(rng);
     rays.push_back(make_ray({-3.0f, 1.0f, z - 2.0f * dz}, {1.0f, 0.0f, dz}));
   }
-  run_everywhere(cube, rays, [&](const std::string&, Query, const std::vector<Hit>& hits) {
+  // Any hit may report the far face instead (the judge checks it is a hit);
+  // closest hit must report the edge ahead.
+  run_everywhere(cube, rays, [&](const std::string&, Query query, const std::vector<Hit>& hits) {
+    if (query != Query::closest) return;
     std::size_t wrong = 0;
     std::string first;
     for (std::size_t i = 0; i < hits.size(); ++i) {
@@ -762,18 +765,20 @@ TEST(Adversarial, SphereTangentAndInsideRays) {
   // Exactly tangent (or within 1e-6 radii): hit or miss are both right, but
   // a hit is on that sphere, on its surface. (t itself is ill-conditioned
   // there: the half-chord grows as the square root of the distance.)
-  run_everywhere(g, tangent, [&](const std::string&, Query, const std::vector<Hit>& hits) {
+  // Any hit may report a sphere further along instead of the tangent one.
+  run_everywhere(g, tangent, [&](const std::string&, Query query, const std::vector<Hit>& hits) {
     for (std::size_t i = 0; i < hits.size(); ++i) {
       if (hits[i].prim < 0) continue;
-      ASSERT_EQ(hits[i].prim, static_cast<int>(i / 200)) << describe(tangent[i]);
+      if (query == Query::closest) ASSERT_EQ(hits[i].prim, static_cast<int>(i / 200)) << describe(tangent[i]);
       EXPECT_LT(off_surface(tangent[i], hits[i]), 1e-5) << describe(tangent[i]);
     }
   }, {.judge = false});
   // From inside (the centre included): the far side, at t > 0.
   run_everywhere(g, inside, [&](const std::string&, Query query, const std::vector<Hit>& hits) {
     for (std::size_t i = 0; i < hits.size(); ++i) {
-      ASSERT_EQ(hits[i].prim, inside_sphere[i]) << "from inside: " << describe(inside[i]);
+      ASSERT_GE(hits[i].prim, 0) << "from inside: " << describe(inside[i]);
       if (query == Query::closest) {
+        ASSERT_EQ(hits[i].prim, inside_sphere[i]) << "from inside: " << describe(inside[i]);
         EXPECT_GT(hits[i].t, 0.0f) << describe(inside[i]);
         EXPECT_LT(off_surface(inside[i], hits[i]), 1e-5) << describe(inside[i]);
       }

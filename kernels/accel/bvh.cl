@@ -1,19 +1,37 @@
-/* 8-wide BVH traversal, one ray per work-item: the eight child boxes of a node
- * are tested at once in float8 lanes; leaves are blocks of eight primitives.
- * Closest hit visits hit children nearest first and skips any whose entry
- * distance is beyond the current hit; any hit stops at the first hit. */
+/* 8-wide BVH traversal, one ray per work-item (the shape of Embree's
+ * single-ray BVH8 traversal, Wald et al. 2014, "Embree: a kernel framework
+ * for efficient CPU ray tracing"): the eight child boxes of a node are tested
+ * at once in float8 lanes (intersect_boxes8); leaves are blocks of eight
+ * primitives, also tested in float8 lanes.
+ *
+ * Closest hit: the children a ray enters are pushed sorted by entry
+ * distance, nearest on top, and the top is taken next; an entry popped with
+ * an entry distance beyond the current hit is skipped. Any hit: pushed in
+ * lane order, and the first hit ends the traversal.
+ *
+ * Stack: a node with k children pushes at most k entries and pops one, so
+ * the stack never holds more than, over all nodes v, the sum of
+ * (children - 1) over v's ancestors plus v's children. The host computes
+ * that bound from the tree (flatten_bvh8) and compiles with
+ * -DRTCL_STACK_SIZE >= it.
+ *
+ * Shape chosen by measurement on PoCL (CPU, AVX2), where each work-item runs
+ * as scalar code around the explicit float8 operations: a per-lane branch
+ * with a constant lane index (extracted from registers) beat bit-mask
+ * iteration, a branch-free compaction and a float8 sorting network; the
+ * traversal stays a separate function (its private arrays stay on the
+ * native stack instead of becoming per-work-item arrays). */
 #include "shared/trace.h"
 
-/* Entries the traversal stack needs; the host computes it from the tree. */
 #ifndef RTCL_STACK_SIZE
 #define RTCL_STACK_SIZE 64
 #endif
 
-inline void bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
-                         global const TriangleBlock* triangles, global const SphereBlock* spheres,
-                         const int any_hit) {
+__attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
+                                            global const TriangleBlock* triangles,
+                                            global const SphereBlock* spheres, const int any_hit) {
   int stack_ref[RTCL_STACK_SIZE];
-  float stack_t[RTCL_STACK_SIZE];
+  float stack_t[RTCL_STACK_SIZE]; /* entry distance of stack_ref's box */
   int sp = 0;
   int ref = 0;
   for (;;) {
@@ -21,25 +39,24 @@ inline void bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* 
       global const Bvh8Node* node = nodes + ref;
       float8 t_entry;
       int8 hit = intersect_boxes8(node, s, h->t_best, &t_entry);
-      if (any(hit)) {
-        int hit_lanes[8];
-        float t_lanes[8];
-        vstore8(hit, 0, hit_lanes);
-        vstore8(t_entry, 0, t_lanes);
+      if (rtcl_any8(hit)) {
         int base = sp;
-        for (int i = 0; i < 8; ++i) {
-          if (!hit_lanes[i]) continue;
-          float t = t_lanes[i];
-          int j = sp++;
-          /* keep [base, sp) sorted by decreasing entry distance: nearest on top */
-          while (!any_hit && j > base && stack_t[j - 1] < t) {
-            stack_t[j] = stack_t[j - 1];
-            stack_ref[j] = stack_ref[j - 1];
-            --j;
-          }
-          stack_t[j] = t;
-          stack_ref[j] = node->child[i];
-        }
+        /* insertion into [base, sp) kept sorted by decreasing distance */
+#define BVH_PUSH_LANE(k)                                     \
+  if (hit.s##k) {                                            \
+    float t = t_entry.s##k;                                  \
+    int j = sp++;                                            \
+    while (!any_hit && j > base && stack_t[j - 1] < t) {     \
+      stack_t[j] = stack_t[j - 1];                           \
+      stack_ref[j] = stack_ref[j - 1];                       \
+      --j;                                                   \
+    }                                                        \
+    stack_t[j] = t;                                          \
+    stack_ref[j] = node->child[k];                           \
+  }
+        BVH_PUSH_LANE(0) BVH_PUSH_LANE(1) BVH_PUSH_LANE(2) BVH_PUSH_LANE(3)
+        BVH_PUSH_LANE(4) BVH_PUSH_LANE(5) BVH_PUSH_LANE(6) BVH_PUSH_LANE(7)
+#undef BVH_PUSH_LANE
       }
     } else {
       int leaf = ~ref;

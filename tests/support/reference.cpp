@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include <glm/glm.hpp>
 
@@ -25,7 +26,12 @@ double distance_to_segment(const glm::dvec3& p, const glm::dvec3& a, const glm::
 
 }  // namespace
 
-PrimHit reference_intersect(const Geometry& g, std::uint32_t prim, const Ray& ray) {
+namespace {
+
+// reference_intersect with the ray's tolerance given (it costs a pass over
+// the scene). With inside_only, a triangle the ray's plane point falls
+// outside of returns plane = false at once (its margin is not needed).
+PrimHit intersect(const Geometry& g, std::uint32_t prim, const Ray& ray, const Tolerance& tol, bool inside_only) {
   PrimHit out;
   glm::dvec3 o = origin(ray), d = direction(ray);
   if (prim < g.triangles.size()) {
@@ -34,14 +40,16 @@ PrimHit reference_intersect(const Geometry& g, std::uint32_t prim, const Ray& ra
     glm::dvec3 n = glm::cross(b - a, c - a);
     double denom = glm::dot(n, d);
     if (denom == 0.0 || glm::dot(n, n) == 0.0) return out;
-    out.plane = true;
-    out.t = glm::dot(n, a - o) / denom;
-    glm::dvec3 p = o + out.t * d;
+    double t = glm::dot(n, a - o) / denom;
+    glm::dvec3 p = o + t * d;
     // inside test by edge signs; margin = distance to the nearest edge
     double s0 = glm::dot(glm::cross(b - a, p - a), n), s1 = glm::dot(glm::cross(c - b, p - b), n),
            s2 = glm::dot(glm::cross(a - c, p - c), n);
-    double dist = std::min({distance_to_segment(p, a, b), distance_to_segment(p, b, c), distance_to_segment(p, c, a)});
     bool inside = s0 >= 0 && s1 >= 0 && s2 >= 0;
+    if (inside_only && !inside) return out;
+    out.plane = true;
+    out.t = t;
+    double dist = std::min({distance_to_segment(p, a, b), distance_to_segment(p, b, c), distance_to_segment(p, c, a)});
     out.margin = inside ? dist : -dist;
     return out;
   }
@@ -56,26 +64,34 @@ PrimHit reference_intersect(const Geometry& g, std::uint32_t prim, const Ray& ra
   out.plane = true;
   double half = dist < r ? std::sqrt(r * r - dist * dist) / std::sqrt(a) : 0.0;
   double t0 = tc - half, t1 = tc + half;
-  Tolerance tol = tolerance_for(g, ray);
   out.t = t0 >= ray.tmin - tol.t ? t0 : t1;
   return out;
 }
 
-Tolerance tolerance_for(const Geometry& g, const Ray& ray, double ulps) {
-  Aabb box = g.bounds();
+}  // namespace
+
+PrimHit reference_intersect(const Geometry& g, std::uint32_t prim, const Ray& ray) {
+  return intersect(g, prim, ray, tolerance_for(g, ray), false);
+}
+
+namespace {
+
+// The scene's bounds cost a pass over every primitive: the functions below
+// take them computed once.
+Tolerance tolerance_in(const Aabb& box, const Ray& ray, double ulps) {
   glm::dvec3 lo(box.lower), hi(box.upper), o = origin(ray);
   double magnitude = std::max({glm::length(hi - lo), glm::length(lo), glm::length(hi), glm::length(o)});
   double space = ulps * FLT_EPSILON * magnitude;
   return {space, space / glm::length(direction(ray))};
 }
 
-Hit reference_closest(const Geometry& g, const Ray& ray) {
+Hit closest_in(const Geometry& g, const Aabb& box, const Ray& ray) {
   Hit best{std::numeric_limits<float>::infinity(), 0.0f, 0.0f, -1};
   double best_t = kInf;
-  Tolerance tol = tolerance_for(g, ray);
+  Tolerance tol = tolerance_in(box, ray, 256.0);
   for (std::uint32_t p = 0; p < g.primitive_count(); ++p) {
     if (p < g.triangles.size() && zero_area(g, p)) continue;
-    PrimHit h = reference_intersect(g, p, ray);
+    PrimHit h = intersect(g, p, ray, tol, true);
     if (!h.plane || h.margin <= tol.space) continue;
     if (h.t < ray.tmin + tol.t || h.t > ray.tmax - tol.t) continue;
     if (h.t < best_t) {
@@ -87,8 +103,10 @@ Hit reference_closest(const Geometry& g, const Ray& ray) {
   return best;
 }
 
-std::string judge(const Geometry& g, const Ray& ray, const Hit& device, Query query) {
-  Tolerance tol = tolerance_for(g, ray);
+// judge, with the ray's reference_closest when `known` is not null.
+std::string judge_in(const Geometry& g, const Aabb& box, const Ray& ray, const Hit& device, Query query,
+                     const Hit* known) {
+  Tolerance tol = tolerance_in(box, ray, 256.0);
   std::ostringstream why;
   double device_t = device.prim >= 0 ? static_cast<double>(device.t) : kInf;
   if (device.prim >= 0) {
@@ -96,7 +114,7 @@ std::string judge(const Geometry& g, const Ray& ray, const Hit& device, Query qu
       why << "device prim " << device.prim << " out of range";
       return why.str();
     }
-    PrimHit h = reference_intersect(g, static_cast<std::uint32_t>(device.prim), ray);
+    PrimHit h = intersect(g, static_cast<std::uint32_t>(device.prim), ray, tol, false);
     if (!h.plane || h.margin < -tol.space || std::abs(h.t - device_t) > tol.t) {
       why << "device hit prim " << device.prim << " at t=" << device.t << " but the reference has plane=" << h.plane
           << " t=" << h.t << " margin=" << h.margin << " (tolerance " << tol.space << ")";
@@ -110,7 +128,7 @@ std::string judge(const Geometry& g, const Ray& ray, const Hit& device, Query qu
     why << "miss must be t=inf prim=-1, got t=" << device.t << " prim=" << device.prim;
     return why.str();
   }
-  Hit ref = reference_closest(g, ray);
+  Hit ref = known ? *known : closest_in(g, box, ray);
   if (ref.prim < 0) return "";
   if (query == Query::any) {
     if (device.prim < 0) {
@@ -128,12 +146,14 @@ std::string judge(const Geometry& g, const Ray& ray, const Hit& device, Query qu
   return "";
 }
 
-std::vector<std::string> judge_all(const Geometry& g, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
-                                   Query query, std::size_t* failures, std::size_t report) {
+std::vector<std::string> judge_rays(const Geometry& g, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                                    Query query, const std::vector<Hit>* references, std::size_t* failures,
+                                    std::size_t report) {
   std::vector<std::string> out;
   *failures = 0;
+  Aabb box = g.bounds();
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    std::string why = judge(g, rays[i], hits[i], query);
+    std::string why = judge_in(g, box, rays[i], hits[i], query, references ? &(*references)[i] : nullptr);
     if (why.empty()) continue;
     ++*failures;
     if (out.size() < report) {
@@ -146,6 +166,36 @@ std::vector<std::string> judge_all(const Geometry& g, const std::vector<Ray>& ra
     }
   }
   return out;
+}
+
+}  // namespace
+
+Tolerance tolerance_for(const Geometry& g, const Ray& ray, double ulps) { return tolerance_in(g.bounds(), ray, ulps); }
+
+Hit reference_closest(const Geometry& g, const Ray& ray) { return closest_in(g, g.bounds(), ray); }
+
+std::vector<Hit> reference_closest_all(const Geometry& g, const std::vector<Ray>& rays) {
+  Aabb box = g.bounds();
+  std::vector<Hit> out;
+  out.reserve(rays.size());
+  for (const Ray& r : rays) out.push_back(closest_in(g, box, r));
+  return out;
+}
+
+std::string judge(const Geometry& g, const Ray& ray, const Hit& device, Query query) {
+  return judge_in(g, g.bounds(), ray, device, query, nullptr);
+}
+
+std::vector<std::string> judge_all(const Geometry& g, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                                   Query query, std::size_t* failures, std::size_t report) {
+  return judge_rays(g, rays, hits, query, nullptr, failures, report);
+}
+
+std::vector<std::string> judge_all(const Geometry& g, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                                   Query query, const std::vector<Hit>& references, std::size_t* failures,
+                                   std::size_t report) {
+  if (references.size() != rays.size()) throw std::invalid_argument("judge_all: one reference per ray expected");
+  return judge_rays(g, rays, hits, query, &references, failures, report);
 }
 
 }  // namespace rtcl::test

@@ -44,4 +44,14 @@ std::vector<std::string> judge_all(const Geometry& geometry, const std::vector<R
                                    const std::vector<Hit>& hits, Query query, std::size_t* failures,
                                    std::size_t report = 5);
 
+// reference_closest for every ray. The reference is O(primitives) per ray:
+// compute it once and pass it to the judge_all below when several answers
+// (structures, queries) are judged for the same rays of a large scene.
+std::vector<Hit> reference_closest_all(const Geometry& geometry, const std::vector<Ray>& rays);
+
+// judge_all with references[i] == reference_closest(geometry, rays[i]).
+std::vector<std::string> judge_all(const Geometry& geometry, const std::vector<Ray>& rays,
+                                   const std::vector<Hit>& hits, Query query, const std::vector<Hit>& references,
+                                   std::size_t* failures, std::size_t report = 5);
+
 }  // namespace rtcl::test

@@ -4,6 +4,7 @@
 
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/accel/brute.hpp"
+#include "rtcl/accel/bvh.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {
@@ -15,6 +16,8 @@ using Factory = std::function<std::unique_ptr<Accel>(const Device&, const Geomet
 const std::vector<std::pair<std::string, Factory>>& registry() {
   static const std::vector<std::pair<std::string, Factory>> entries = {
       {"brute", make_brute},
+      {"bvh", make_bvh_sah},
+      {"bvh-ploc", make_bvh_ploc},
   };
   return entries;
 }

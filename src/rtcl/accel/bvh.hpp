@@ -1,0 +1,83 @@
+// 8-wide bounding volume hierarchy: a binary build tree (binned SAH or PLOC)
+// collapsed into Bvh8Node records (kernels/shared/layouts.h) whose eight
+// child boxes the kernel tests at once in float8 lanes, with leaves that are
+// blocks of up to eight triangles or eight spheres.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel/build_tree.hpp"
+#include "rtcl/accel/bvh_ploc.hpp"
+#include "rtcl/accel/bvh_sah.hpp"
+#include "rtcl/accel/primitive_blocks.hpp"
+#include "rtcl/layouts.hpp"
+
+namespace rtcl {
+
+enum class BvhBuilder {
+  sah,   // top-down binned SAH (bvh_sah.hpp): the default, best trace speed
+  ploc,  // bottom-up clustering (bvh_ploc.hpp)
+};
+
+struct BvhConfig {
+  BvhBuilder builder = BvhBuilder::sah;
+  SahConfig sah;
+  PlocConfig ploc;
+  // Collapse: two leaves of one wide node share a block when their
+  // primitives fit in eight lanes and the SAH does not object (the union's
+  // area is at most the sum of theirs): one block test instead of two, fewer
+  // bytes. Rarely applies to SAH trees, whose leaves are already full (bunny:
+  // 2 blocks of 9,465 saved); off changes nothing else.
+  bool merge_leaves = true;
+};
+
+// The host image of what the kernel reads.
+struct Bvh8 {
+  std::vector<Bvh8Node> nodes;   // nodes[0] is the root
+  PrimitiveBlocks blocks;        // primitives in leaf order
+  // Traversal stack entries the kernel needs for this tree (exact): the
+  // maximum over nodes of their children plus (children - 1) of each
+  // ancestor (kernels/accel/bvh.cl).
+  std::uint32_t stack_size = 0;
+  std::uint32_t depth = 0;       // wide levels on the longest root-to-leaf path
+};
+
+// The binary tree over the geometry's stored primitives (zero-area
+// triangles skipped); leaves hold primitive ids. Triangles and spheres are
+// built separately and joined under one root, so no leaf mixes them.
+// Geometry must have passed validate().
+BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config = {});
+
+// Collapses the binary tree into 8-wide nodes: each wide node takes the two
+// children of a binary node and keeps opening the child with the largest
+// surface area until it has eight children or only leaves (then merges small
+// sibling leaves when `merge_leaves`). Checked: throws Error when the tree
+// does not hold every stored primitive of `geometry` exactly once in leaves
+// of 1..8 primitives of one kind, or its stack need exceeds
+// kBvhMaxStackSize.
+Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves = true);
+
+// The largest traversal stack the kernel is compiled for (entries of 8 bytes
+// per work-item); a deeper tree is refused with an Error.
+inline constexpr std::uint32_t kBvhMaxStackSize = 1024;
+
+// The RTCL_STACK_SIZE the kernel is compiled with for a tree needing
+// `stack_size` entries: rounded up to a multiple of 8 (fewer distinct
+// programs), at least 8.
+std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size);
+
+// Builds, flattens and uploads; stats().build_ms covers build + flatten.
+// `name` is what Accel::name() reports ("bvh", "bvh-ploc").
+std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config = {},
+                                std::string name = "bvh");
+
+// The registered structures: "bvh" (binned SAH, default config) and
+// "bvh-ploc" (PLOC, default config).
+std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry);
+std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry);
+
+}  // namespace rtcl

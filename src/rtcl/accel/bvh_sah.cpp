@@ -1,0 +1,302 @@
+#include "rtcl/accel/bvh_sah.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <vector>
+
+#include "rtcl/error.hpp"
+#include "rtcl/layouts.hpp"
+
+namespace rtcl {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr std::uint32_t kMaxBins = 256;
+
+// Four floats in one SIMD register (GCC/Clang vector extension): x, y, z
+// and a spare lane. Boxes grow with two 4-wide min/max operations.
+typedef float Float4 __attribute__((vector_size(16)));
+typedef int Int4 __attribute__((vector_size(16)));
+
+inline Float4 min4(Float4 a, Float4 b) { return b < a ? b : a; }
+inline Float4 max4(Float4 a, Float4 b) { return a < b ? b : a; }
+
+// Trivially constructible (bins live uninitialised on the stack): start
+// from Box::empty().
+struct Box {
+  Float4 lo, hi;
+
+  static Box empty() { return {Float4{kInf, kInf, kInf, kInf}, Float4{-kInf, -kInf, -kInf, -kInf}}; }
+
+  void grow(const Box& b) {
+    lo = min4(lo, b.lo);
+    hi = max4(hi, b.hi);
+  }
+  void grow_point(Float4 p) {
+    lo = min4(lo, p);
+    hi = max4(hi, p);
+  }
+  float area() const {
+    Float4 e = hi - lo;
+    return e[0] < 0.0f ? 0.0f : 2.0f * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
+  }
+  Aabb aabb() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
+};
+
+// A primitive during the build: its box (lane 3 of hi holds the id's bits),
+// 32 bytes, partitioned in place so that every subtree's primitives stay
+// contiguous.
+struct PrimRef {
+  Box box;
+  std::uint32_t id() const { return std::bit_cast<std::uint32_t>(box.hi[3]); }
+  // Box centre, halves first (no overflow near the float range's ends).
+  Float4 centre() const { return 0.5f * box.lo + 0.5f * box.hi; }
+};
+
+inline float blocks(std::uint32_t n) { return static_cast<float>((n + RTCL_BLOCK_WIDTH - 1) / RTCL_BLOCK_WIDTH); }
+
+struct Split {
+  int axis = -1;          // -1: no plane separates the centroids
+  std::uint32_t bin = 0;  // left side: bins [0, bin)
+  float cost = kInf;      // area-weighted, in block tests
+  // bins of centre c (bins_of), per axis
+  Float4 offset = {0, 0, 0, 0}, scale = {0, 0, 0, 0}, last_bin = {0, 0, 0, 0};
+  Box left = Box::empty(), right = Box::empty();
+};
+
+// Bin indices of a centre along each axis, in [0, last_bin]; clamped as
+// floats first, so that the conversion is defined for any input (NaN: 0).
+inline Int4 bins_of(Float4 centre, Float4 offset, Float4 scale, Float4 last_bin) {
+  Float4 k = (centre - offset) * scale;
+  Float4 zero = {0.0f, 0.0f, 0.0f, 0.0f};
+  k = zero < k ? k : zero;  // NaN -> 0
+  k = min4(k, last_bin);
+  return __builtin_convertvector(k, Int4);
+}
+
+// A node's primitives: refs[begin, end), their bounds and their centres'.
+struct Range {
+  std::uint32_t begin, end;
+  Box bounds, centres;
+};
+
+class SahBuilder {
+ public:
+  SahBuilder(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config)
+      : config_(config), refs_(bounds.size()), nodes_(2 * bounds.size()) {
+    for (std::size_t i = 0; i < bounds.size(); ++i) {
+      const Aabb& b = bounds[i];
+      refs_[i].box = {Float4{b.lower.x, b.lower.y, b.lower.z, 0.0f},
+                      Float4{b.upper.x, b.upper.y, b.upper.z, std::bit_cast<float>(ids[i])}};
+    }
+    unsigned threads = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
+    spare_threads_ = static_cast<int>(threads) - 1;
+  }
+
+  BuildTree run() {
+    BuildTree tree;
+    if (refs_.empty()) return tree;
+    Range all{0, static_cast<std::uint32_t>(refs_.size()), Box::empty(), Box::empty()};
+    for (const PrimRef& r : refs_) {
+      all.bounds.grow(r.box);
+      all.centres.grow_point(r.centre());
+    }
+    build(0, all, 1);
+    nodes_.resize(node_count_.load());
+    tree.nodes = std::move(nodes_);
+    tree.prims.resize(refs_.size());
+    for (std::size_t i = 0; i < refs_.size(); ++i) tree.prims[i] = refs_[i].id();
+    return tree;
+  }
+
+ private:
+  // Best SAH plane over bins of the centroids in the range. Nodes below
+  // 32 * bin_count primitives use n / 32 bins, at least 16: a node's cost is
+  // O(n + bins), and the bins that matter are those of the large nodes near
+  // the root. Not inlined: its ~20 KB of bins must not sit in every frame of
+  // the recursion.
+  [[gnu::noinline]] Split find_split(const Range& range) const {
+    const std::uint32_t n = range.end - range.begin;
+    const std::uint32_t k_count = std::min(config_.bin_count, std::max(16u, n / 32));
+    Box bin_box[3][kMaxBins];
+    std::uint32_t bin_n[3][kMaxBins];
+    Float4 offset = {0, 0, 0, 0}, scale = {0, 0, 0, 0};
+    const auto last = static_cast<float>(k_count - 1);
+    const Float4 last_bin = {last, last, last, last};
+    bool usable[3];
+    for (int a = 0; a < 3; ++a) {
+      for (std::uint32_t k = 0; k < k_count; ++k) {
+        bin_box[a][k] = Box::empty();
+        bin_n[a][k] = 0;
+      }
+      float extent = range.centres.hi[a] - range.centres.lo[a];
+      offset[a] = range.centres.lo[a];
+      float sc = static_cast<float>(k_count) * (1.0f - 4.0f * std::numeric_limits<float>::epsilon()) / extent;
+      usable[a] = extent > 0.0f && std::isfinite(extent) && std::isfinite(sc) && sc > 0.0f;
+      scale[a] = usable[a] ? sc : 0.0f;
+    }
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      const PrimRef& r = refs_[i];
+      Int4 k = bins_of(r.centre(), offset, scale, last_bin);
+      for (int a = 0; a < 3; ++a) {
+        bin_box[a][k[a]].grow(r.box);
+        ++bin_n[a][k[a]];
+      }
+    }
+    Split best;
+    float right_area[kMaxBins];
+    std::uint32_t right_n[kMaxBins];
+    for (int a = 0; a < 3; ++a) {
+      if (!usable[a]) continue;
+      Box acc = Box::empty();
+      std::uint32_t count = 0;
+      for (std::uint32_t k = k_count - 1; k > 0; --k) {
+        acc.grow(bin_box[a][k]);
+        count += bin_n[a][k];
+        right_area[k] = acc.area();
+        right_n[k] = count;
+      }
+      acc = Box::empty();
+      count = 0;
+      for (std::uint32_t k = 1; k < k_count; ++k) {
+        acc.grow(bin_box[a][k - 1]);
+        count += bin_n[a][k - 1];
+        if (count == 0 || right_n[k] == 0) continue;
+        float cost = acc.area() * blocks(count) + right_area[k] * blocks(right_n[k]);
+        if (cost < best.cost) {
+          best.cost = cost;
+          best.axis = a;
+          best.bin = k;
+        }
+      }
+    }
+    if (best.axis >= 0) {
+      int a = best.axis;
+      best.offset = offset;
+      best.scale = scale;
+      best.last_bin = last_bin;
+      for (std::uint32_t k = 0; k < k_count; ++k) (k < best.bin ? best.left : best.right).grow(bin_box[a][k]);
+    }
+    return best;
+  }
+
+  // Partitions the range by the split's plane; fills both sides' centre
+  // bounds (the boxes come from the bins). Both sides are non-empty.
+  std::uint32_t partition(const Range& range, const Split& split, Range& left, Range& right) {
+    const int a = split.axis;
+    auto goes_left = [&](Float4 c) {
+      return bins_of(c, split.offset, split.scale, split.last_bin)[a] < static_cast<int>(split.bin);
+    };
+    std::uint32_t i = range.begin, j = range.end;
+    for (;;) {
+      for (; i < j; ++i) {
+        Float4 c = refs_[i].centre();
+        if (!goes_left(c)) break;
+        left.centres.grow_point(c);
+      }
+      for (; i < j; --j) {
+        Float4 c = refs_[j - 1].centre();
+        if (goes_left(c)) break;
+        right.centres.grow_point(c);
+      }
+      if (i >= j) break;
+      std::swap(refs_[i], refs_[j - 1]);
+    }
+    return i;
+  }
+
+  // Object median along the longest centroid axis: both halves non-empty.
+  std::uint32_t median_split(const Range& range) {
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+      if (range.centres.hi[a] - range.centres.lo[a] > range.centres.hi[axis] - range.centres.lo[axis]) axis = a;
+    std::uint32_t mid = range.begin + (range.end - range.begin) / 2;
+    std::nth_element(refs_.begin() + range.begin, refs_.begin() + mid, refs_.begin() + range.end,
+                     [axis](const PrimRef& x, const PrimRef& y) { return x.centre()[axis] < y.centre()[axis]; });
+    return mid;
+  }
+
+  void build(std::uint32_t node, const Range& range, std::uint32_t depth) {
+    const std::uint32_t n = range.end - range.begin;
+    const float area = range.bounds.area();
+    Split split;
+    if (n > 1 && depth < config_.max_sah_depth) split = find_split(range);
+    if (n <= config_.max_leaf_size &&
+        (split.axis < 0 || area * blocks(n) <= config_.node_cost * area + split.cost)) {
+      BuildNode& leaf = nodes_[node];
+      leaf.bounds = range.bounds.aabb();
+      leaf.first = range.begin;
+      leaf.count = n;
+      return;
+    }
+    Range left{range.begin, 0, Box::empty(), Box::empty()}, right{0, range.end, Box::empty(), Box::empty()};
+    if (split.axis >= 0) {
+      left.end = right.begin = partition(range, split, left, right);
+      left.bounds = split.left;
+      right.bounds = split.right;
+    }
+    // The partition recomputes the bins the counts came from, so neither side
+    // is empty; should rounding ever disagree, the median split takes over.
+    if (split.axis < 0 || left.end == left.begin || right.begin == right.end) {
+      left.bounds = left.centres = right.bounds = right.centres = Box::empty();
+      left.end = right.begin = median_split(range);
+      for (std::uint32_t i = left.begin; i < left.end; ++i) {
+        left.bounds.grow(refs_[i].box);
+        left.centres.grow_point(refs_[i].centre());
+      }
+      for (std::uint32_t i = right.begin; i < right.end; ++i) {
+        right.bounds.grow(refs_[i].box);
+        right.centres.grow_point(refs_[i].centre());
+      }
+    }
+    std::uint32_t first_child = node_count_.fetch_add(2);
+    BuildNode& inner = nodes_[node];
+    inner.bounds = range.bounds.aabb();
+    inner.child[0] = first_child;
+    inner.child[1] = first_child + 1;
+    if (n >= config_.parallel_min_primitives && try_take_thread()) {
+      std::thread worker([&] { build(first_child, left, depth + 1); });
+      build(first_child + 1, right, depth + 1);
+      worker.join();
+      spare_threads_.fetch_add(1);
+    } else {
+      build(first_child, left, depth + 1);
+      build(first_child + 1, right, depth + 1);
+    }
+  }
+
+  bool try_take_thread() {
+    int spare = spare_threads_.load();
+    while (spare > 0)
+      if (spare_threads_.compare_exchange_weak(spare, spare - 1)) return true;
+    return false;
+  }
+
+  const SahConfig& config_;
+  std::vector<PrimRef> refs_;
+  std::vector<BuildNode> nodes_;  // at most 2n - 1 for n primitives
+  std::atomic<std::uint32_t> node_count_{1};
+  std::atomic<int> spare_threads_{0};
+};
+
+}  // namespace
+
+BuildTree build_sah(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config) {
+  if (config.bin_count < 2 || config.bin_count > kMaxBins)
+    throw Error("SAH builder: bin_count " + std::to_string(config.bin_count) + " is outside 2..256");
+  if (config.max_leaf_size < 1 || config.max_leaf_size > RTCL_BLOCK_WIDTH)
+    throw Error("SAH builder: max_leaf_size " + std::to_string(config.max_leaf_size) + " is outside 1..8");
+  if (!(config.node_cost >= 0.0f) || !std::isfinite(config.node_cost))
+    throw Error("SAH builder: node_cost must be finite and >= 0");
+  if (config.max_sah_depth > 1024)
+    throw Error("SAH builder: max_sah_depth " + std::to_string(config.max_sah_depth) + " is above 1024");
+  check_builder_input(bounds, ids, "SAH builder");
+  return SahBuilder(bounds, ids, config).run();
+}
+
+}  // namespace rtcl

@@ -1,0 +1,436 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <random>
+
+#include "rtcl/accel/bvh.hpp"
+#include "rtcl/error.hpp"
+#include "rtcl/scene/mesh_io.hpp"
+#include "support/fixtures.hpp"
+#include "support/reference.hpp"
+
+namespace rtcl::test {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+const char* builder_name(BvhBuilder b) { return b == BvhBuilder::sah ? "sah" : "ploc"; }
+
+BvhConfig config_for(BvhBuilder b) {
+  BvhConfig config;
+  config.builder = b;
+  return config;
+}
+
+const char* accel_for(BvhBuilder b) { return b == BvhBuilder::sah ? "bvh" : "bvh-ploc"; }
+
+// The builder inputs build_binary_bvh derives: stored primitives with their
+// boxes (spheres widened as the BVH widens them, so compare loosely).
+struct Inputs {
+  std::vector<Aabb> bounds;
+  std::vector<std::uint32_t> ids;
+};
+Inputs triangle_inputs(const Geometry& g) {
+  Inputs in;
+  for (std::uint32_t p : stored_primitives(g))
+    if (p < g.triangles.size()) {
+      in.bounds.push_back(g.primitive_bounds(p));
+      in.ids.push_back(p);
+    }
+  return in;
+}
+
+BuildTree build_with(BvhBuilder b, const Inputs& in) {
+  return b == BvhBuilder::sah ? build_sah(in.bounds, in.ids) : build_ploc(in.bounds, in.ids);
+}
+
+bool box_contains(const float bounds[6][RTCL_BLOCK_WIDTH], int lane, const Aabb& box) {
+  for (int a = 0; a < 3; ++a)
+    if (!(bounds[a][lane] <= box.lower[a] && bounds[3 + a][lane] >= box.upper[a])) return false;
+  return true;
+}
+
+// Independent walk of the device layout: every stored primitive in exactly
+// one block lane, every child box containing all primitives below it, and
+// the stack bound recomputed as the kernel uses the stack (a node pushes its
+// children, then one is popped): max over nodes of children + the sum of
+// (children - 1) over the ancestors. "" when all hold.
+std::string check_wide(const Bvh8& bvh, const Geometry& g) {
+  std::vector<int> seen(g.primitive_count(), 0);
+  std::uint32_t stack_need = 0;
+  std::vector<int> node_seen(bvh.nodes.size(), 0);
+  std::string problem;
+  // Returns the union of the primitive boxes below child reference `ref`.
+  std::function<Aabb(rtcl_i32, std::uint32_t)> walk = [&](rtcl_i32 ref, std::uint32_t stack) -> Aabb {
+    Aabb below;
+    if (ref >= 0) {
+      if (static_cast<std::size_t>(ref) >= bvh.nodes.size() || node_seen[ref]++) {
+        problem = "node " + std::to_string(ref) + " missing or reached twice";
+        return below;
+      }
+      const Bvh8Node& node = bvh.nodes[ref];
+      std::uint32_t children = 0;
+      for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) children += node.child[lane] != RTCL_CHILD_EMPTY;
+      if (children == 0) problem = "node " + std::to_string(ref) + " has no child";
+      stack_need = std::max(stack_need, stack + children);  // pushed, before one is popped
+      std::uint32_t need = stack + children - 1;
+      for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+        if (node.child[lane] == RTCL_CHILD_EMPTY) {
+          if (!(node.bounds[0][lane] == kInf && node.bounds[3][lane] == -kInf))
+            problem = "empty slot with a box in node " + std::to_string(ref);
+          continue;
+        }
+        Aabb child = walk(node.child[lane], need);
+        if (!box_contains(node.bounds, lane, child))
+          problem = "node " + std::to_string(ref) + " lane " + std::to_string(lane) + " misses a primitive";
+        below.grow(child);
+      }
+      return below;
+    }
+    int leaf = ~ref;
+    bool spheres = leaf & 1;
+    std::size_t block = static_cast<std::size_t>(leaf >> 1);
+    if (block >= (spheres ? bvh.blocks.spheres.size() : bvh.blocks.triangles.size())) {
+      problem = "leaf reference to a missing block";
+      return below;
+    }
+    const rtcl_i32* prims = spheres ? bvh.blocks.spheres[block].prim : bvh.blocks.triangles[block].prim;
+    int used = 0;
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+      if (prims[lane] < 0) continue;
+      ++used;
+      ++seen[static_cast<std::size_t>(prims[lane])];
+      below.grow(g.primitive_bounds(static_cast<std::size_t>(prims[lane])));
+    }
+    if (used == 0) problem = "empty block";
+    return below;
+  };
+  walk(0, 0);
+  if (!problem.empty()) return problem;
+  for (std::size_t p = 0; p < seen.size(); ++p) {
+    int expected = p >= g.triangles.size() || !zero_area(g, p) ? 1 : 0;
+    if (seen[p] != expected)
+      return "primitive " + std::to_string(p) + " stored " + std::to_string(seen[p]) + " times";
+  }
+  for (std::size_t n = 0; n < node_seen.size(); ++n)
+    if (!node_seen[n]) return "node " + std::to_string(n) + " unreachable";
+  if (stack_need != bvh.stack_size)
+    return "stack bound " + std::to_string(bvh.stack_size) + ", recomputed " + std::to_string(stack_need);
+  return "";
+}
+
+void expect_matches_reference(const Accel& accel, const Geometry& g, const std::vector<Ray>& rays) {
+  for (Query q : {Query::closest, Query::any}) {
+    auto hits = run_query(accel, rays, q);
+    std::size_t failures = 0;
+    auto report = judge_all(g, rays, hits, q, &failures);
+    EXPECT_EQ(failures, 0u) << accel.name() << (q == Query::closest ? " closest: " : " any: ")
+                            << (report.empty() ? "" : report[0]);
+  }
+}
+
+// Soup of triangles with spheres mixed in, both kinds interleaved in space.
+Geometry soup_with_spheres(std::size_t triangles, std::size_t spheres, std::uint32_t seed) {
+  Geometry g = random_soup(triangles, seed);
+  std::mt19937 rng(seed + 1);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (std::size_t i = 0; i < spheres; ++i)
+    g.spheres.push_back({{unit(rng), unit(rng), unit(rng)}, 0.005f + 0.03f * unit(rng)});
+  return g;
+}
+
+// `count` triangles all centred on one point, each a scaled copy of one
+// shape: every centroid coincides, boxes are nested.
+Geometry nested_triangles(std::size_t count) {
+  Geometry g;
+  g.source = "nested triangles";
+  for (std::size_t i = 0; i < count; ++i) {
+    float s = 0.01f * static_cast<float>(i + 1);
+    auto base = static_cast<std::uint32_t>(g.vertices.size());
+    g.vertices.push_back(glm::vec3(-s, -s, 0.1f * s));
+    g.vertices.push_back(glm::vec3(2.0f * s, -s, -0.2f * s));
+    g.vertices.push_back(glm::vec3(-s, 2.0f * s, 0.1f * s));
+    g.triangles.push_back({base, base + 1, base + 2});
+  }
+  return g;
+}
+
+Geometry identical_triangles(std::size_t count) {
+  Geometry g;
+  g.source = "identical triangles";
+  g.vertices = {{0.0f, 0.0f, 0.0f}, {1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.5f}};
+  g.triangles.assign(count, glm::uvec3(0, 1, 2));
+  return g;
+}
+
+Geometry load(const std::string& relative) {
+  Geometry g = load_mesh(scene_path(relative)).geometry;
+  validate(g);
+  return g;
+}
+
+class BvhBuilders : public ::testing::TestWithParam<BvhBuilder> {};
+
+INSTANTIATE_TEST_SUITE_P(Bvh, BvhBuilders, ::testing::Values(BvhBuilder::sah, BvhBuilder::ploc),
+                         [](const auto& info) { return std::string(builder_name(info.param)); });
+
+TEST_P(BvhBuilders, TreeHoldsEveryPrimitiveOnceInSmallLeaves) {
+  Geometry g = random_soup(5000, 11);
+  Inputs in = triangle_inputs(g);
+  BuildTree tree = build_with(GetParam(), in);
+  EXPECT_EQ(check(tree, in.bounds, in.ids, 8), "");
+  EXPECT_EQ(tree.prims.size(), in.ids.size());
+  // A corrupted tree is caught: the check can fail.
+  BuildTree broken = tree;
+  for (BuildNode& n : broken.nodes)
+    if (n.is_leaf()) {
+      n.bounds.upper.x = n.bounds.lower.x - 1.0f;
+      break;
+    }
+  EXPECT_NE(check(broken, in.bounds, in.ids, 8), "");
+}
+
+TEST_P(BvhBuilders, WideLayoutIsConsistentWithSpheresMixedIn) {
+  Geometry g = soup_with_spheres(3000, 300, 5);
+  Bvh8 bvh = flatten_bvh8(build_binary_bvh(g, config_for(GetParam())), g);
+  EXPECT_EQ(check_wide(bvh, g), "");
+  EXPECT_GT(bvh.stack_size, 0u);
+  EXPECT_GE(bvh_kernel_stack_size(bvh.stack_size), bvh.stack_size);
+  EXPECT_EQ(bvh_kernel_stack_size(bvh.stack_size) % 8, 0u);
+  // No leaf mixes the kinds: blocks hold only their own kind.
+  for (const TriangleBlock& b : bvh.blocks.triangles)
+    for (rtcl_i32 p : b.prim) EXPECT_LT(p, static_cast<rtcl_i32>(g.triangles.size()));
+  for (const SphereBlock& b : bvh.blocks.spheres)
+    for (rtcl_i32 p : b.prim) EXPECT_TRUE(p < 0 || p >= static_cast<rtcl_i32>(g.triangles.size()));
+}
+
+TEST_P(BvhBuilders, DegenerateInputsGiveValidShallowTrees) {
+  struct Case {
+    const char* what;
+    Geometry g;
+    std::uint32_t max_depth;  // binary levels
+  };
+  std::vector<Case> cases;
+  cases.push_back({"one triangle", random_soup(1, 3), 1});
+  cases.push_back({"nine triangles", random_soup(9, 4), 8});
+  cases.push_back({"coincident centroids", nested_triangles(3000), 64 + 12});
+  cases.push_back({"identical triangles", identical_triangles(100000), 20});
+  for (Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    Inputs in = triangle_inputs(c.g);
+    BuildTree tree = build_with(GetParam(), in);
+    EXPECT_EQ(check(tree, in.bounds, in.ids, 8), "");
+    EXPECT_LE(tree.depth(), c.max_depth);
+    Bvh8 bvh = flatten_bvh8(tree, c.g);
+    EXPECT_EQ(check_wide(bvh, c.g), "");
+  }
+}
+
+TEST_P(BvhBuilders, ZeroAreaTrianglesAreNotStored) {
+  Geometry g = random_soup(500, 8);
+  std::size_t n = g.triangles.size();
+  for (std::size_t i = 0; i < n; i += 5) g.triangles[i].z = g.triangles[i].y;  // two equal corners
+  g.vertices.push_back({0.5f, 0.5f, 0.5f});
+  g.triangles.push_back({static_cast<std::uint32_t>(g.vertices.size() - 1), static_cast<std::uint32_t>(g.vertices.size() - 1),
+                         static_cast<std::uint32_t>(g.vertices.size() - 1)});
+  BuildTree tree = build_binary_bvh(g, config_for(GetParam()));
+  EXPECT_EQ(tree.prims.size(), stored_primitives(g).size());
+  EXPECT_EQ(tree.prims.size(), n - n / 5);
+  Bvh8 bvh = flatten_bvh8(tree, g);
+  EXPECT_EQ(check_wide(bvh, g), "");
+  auto accel = make_bvh(test_device(), g, config_for(GetParam()));
+  EXPECT_EQ(accel->stats().zero_area_skipped, n / 5 + 1);
+  EXPECT_EQ(accel->stats().primitive_count, n - n / 5);
+  expect_matches_reference(*accel, g, random_rays(g, 500, 9));
+}
+
+TEST_P(BvhBuilders, MatchesReferenceOnSoupWithSpheres) {
+  Geometry g = soup_with_spheres(2000, 200, 21);
+  auto accel = make_accel(test_device(), accel_for(GetParam()), g);
+  EXPECT_EQ(accel->name(), accel_for(GetParam()));
+  expect_matches_reference(*accel, g, random_rays(g, 2000, 22));
+}
+
+TEST_P(BvhBuilders, MatchesReferenceOnSpheresOnly) {
+  Geometry g;
+  g.source = "spheres";
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int i = 0; i < 300; ++i) g.spheres.push_back({{unit(rng), unit(rng), unit(rng)}, 0.01f + 0.05f * unit(rng)});
+  auto accel = make_accel(test_device(), accel_for(GetParam()), g);
+  expect_matches_reference(*accel, g, random_rays(g, 1000, 4));
+}
+
+TEST_P(BvhBuilders, MatchesReferenceOnDegenerateInputs) {
+  std::vector<Geometry> scenes = {random_soup(1, 31), random_soup(9, 32), nested_triangles(2000),
+                                  identical_triangles(5000)};
+  for (const Geometry& g : scenes) {
+    SCOPED_TRACE(g.source + " of " + std::to_string(g.triangles.size()));
+    auto accel = make_accel(test_device(), accel_for(GetParam()), g);
+    expect_matches_reference(*accel, g, random_rays(g, 300, 33));
+  }
+}
+
+// Rays along the common axis of nested boxes enter every child: the deepest
+// stack the tree allows is used, and must not overflow.
+TEST_P(BvhBuilders, DeepTreesUseTheirWholeStackSafely) {
+  Geometry g = nested_triangles(3000);
+  Bvh8 bvh = flatten_bvh8(build_binary_bvh(g, config_for(GetParam())), g);
+  EXPECT_GE(bvh.stack_size, 16u);
+  auto accel = make_accel(test_device(), accel_for(GetParam()), g);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 64; ++i) {
+    float e = 1e-3f * static_cast<float>(i);
+    rays.push_back({e, e, 10.0f, 0.0f, 0.0f, -1.0f, 0.0f, kInf});
+    rays.push_back({e, -e, -10.0f, 0.0f, 0.0f, 1.0f, 0.0f, kInf});
+  }
+  expect_matches_reference(*accel, g, rays);
+}
+
+// Both structures on real meshes, rays from outside (random_rays) and from
+// random points inside the bounds in random directions (interior views).
+// The double-precision reference is O(triangles) per ray: computed once per
+// ray and shared by the four answers judged.
+void expect_real_mesh_matches(const char* file) {
+  Geometry g = load(file);
+  std::vector<Ray> rays = random_rays(g, 500, 41);
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  Aabb box = g.bounds();
+  for (int i = 0; i < 500; ++i) {
+    glm::vec3 o = box.lower + box.extent() * glm::vec3(unit(rng), unit(rng), unit(rng));
+    rays.push_back({o.x, o.y, o.z, normal(rng), normal(rng), normal(rng), 0.0f, kInf});
+  }
+  std::vector<Hit> references = reference_closest_all(g, rays);
+  for (const char* name : {"bvh", "bvh-ploc"}) {
+    auto accel = make_accel(test_device(), name, g);
+    for (Query q : {Query::closest, Query::any}) {
+      auto hits = run_query(*accel, rays, q);
+      std::size_t failures = 0;
+      auto report = judge_all(g, rays, hits, q, references, &failures);
+      EXPECT_EQ(failures, 0u) << name << (q == Query::closest ? " closest: " : " any: ")
+                              << (report.empty() ? "" : report[0]);
+    }
+  }
+}
+
+TEST(Bvh, MatchesReferenceOnBunny) { expect_real_mesh_matches("stanford_bunny/bunny.obj"); }
+TEST(Bvh, MatchesReferenceOnDragon) { expect_real_mesh_matches("stanford_dragon_100k/dragon.obj"); }
+TEST(Bvh, MatchesReferenceOnSponza) { expect_real_mesh_matches("sponza/sponza.obj"); }
+
+TEST(Bvh, BunnyFitsTheMemoryBudget) {
+  Geometry g = load("stanford_bunny/bunny.obj");
+  for (BvhBuilder b : {BvhBuilder::sah, BvhBuilder::ploc}) {
+    Bvh8 bvh = flatten_bvh8(build_binary_bvh(g, config_for(b)), g);
+    double bytes = static_cast<double>(bvh.nodes.size() * sizeof(Bvh8Node) + bvh.blocks.bytes());
+    EXPECT_LE(bytes / static_cast<double>(g.triangles.size()), 64.0) << builder_name(b);
+  }
+}
+
+TEST(Bvh, StackSizeRoundsUpToMultiplesOfEight) {
+  EXPECT_EQ(bvh_kernel_stack_size(0), 8u);
+  EXPECT_EQ(bvh_kernel_stack_size(8), 8u);
+  EXPECT_EQ(bvh_kernel_stack_size(9), 16u);
+  EXPECT_EQ(bvh_kernel_stack_size(37), 40u);
+}
+
+TEST(Bvh, IsRegistered) {
+  auto names = accel_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "bvh"), names.end());
+  EXPECT_NE(std::find(names.begin(), names.end(), "bvh-ploc"), names.end());
+}
+
+TEST(Bvh, BadBuilderInputIsAnError) {
+  std::vector<Aabb> bounds(3, Aabb{{0, 0, 0}, {1, 1, 1}});
+  std::vector<std::uint32_t> ids = {0, 1};
+  EXPECT_THROW(build_sah(bounds, ids), Error);
+  EXPECT_THROW(build_ploc(bounds, ids), Error);
+  ids.push_back(2);
+  bounds[1].upper.y = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_THROW(build_sah(bounds, ids), Error);
+  EXPECT_THROW(build_ploc(bounds, ids), Error);
+  bounds[1] = Aabb{{0, 2, 0}, {1, 1, 1}};  // lower > upper
+  EXPECT_THROW(build_sah(bounds, ids), Error);
+  bounds[1] = Aabb{{0, 0, 0}, {1, 1, 1}};
+  EXPECT_THROW(build_sah(bounds, ids, {.bin_count = 1}), Error);
+  EXPECT_THROW(build_sah(bounds, ids, {.max_leaf_size = 9}), Error);
+  EXPECT_THROW(build_ploc(bounds, ids, {.search_radius = 0}), Error);
+  EXPECT_THROW(build_ploc(bounds, ids, {.max_leaf_size = 0}), Error);
+  try {
+    build_sah(bounds, ids, {.node_cost = -1.0f});
+    FAIL() << "negative node cost accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("node_cost"), std::string::npos) << e.what();
+  }
+  EXPECT_TRUE(build_sah({}, {}).empty());
+  EXPECT_TRUE(build_ploc({}, {}).empty());
+}
+
+TEST(Bvh, FlattenRejectsTreesThatDoNotMatchTheGeometry) {
+  Geometry g = random_soup(20, 51);
+  BuildTree tree = build_binary_bvh(g);
+  BuildTree missing = tree;
+  for (BuildNode& n : missing.nodes)
+    if (n.is_leaf() && n.count > 1) {
+      --n.count;
+      break;
+    }
+  EXPECT_THROW(flatten_bvh8(missing, g), Error);
+  BuildTree twice = tree;
+  for (BuildNode& n : twice.nodes)
+    if (n.is_leaf()) n.first = 0;
+  EXPECT_THROW(flatten_bvh8(twice, g), Error);
+  EXPECT_THROW(flatten_bvh8(BuildTree{}, g), Error);
+}
+
+// A chain of binary nodes (what a builder without a depth bound makes of
+// nested boxes) needs more stack than the kernel may have: refused.
+TEST(Bvh, FlattenRefusesTreesTooDeepForTheStack) {
+  constexpr std::uint32_t n = 20000;
+  Geometry g = nested_triangles(n);
+  BuildTree chain;
+  for (std::uint32_t i = 0; i < n; ++i) chain.prims.push_back(i);
+  Aabb all = g.bounds();
+  for (std::uint32_t i = 0; i + 1 < n; ++i) {
+    BuildNode inner;
+    inner.bounds = all;
+    inner.child[0] = 2 * i + 1;  // leaf
+    inner.child[1] = 2 * i + 2;  // next inner node (or the last leaf)
+    chain.nodes.push_back(inner);
+    BuildNode leaf;
+    leaf.bounds = all;
+    leaf.first = i;
+    leaf.count = 1;
+    chain.nodes.push_back(leaf);
+  }
+  BuildNode last;
+  last.bounds = all;
+  last.first = n - 1;
+  last.count = 1;
+  chain.nodes.push_back(last);
+  try {
+    flatten_bvh8(chain, g);
+    FAIL() << "a tree deeper than the stack was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("stack"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Bvh, ReportsStats) {
+  Geometry g = random_soup(1000, 61);
+  auto accel = make_accel(test_device(), "bvh", g);
+  const AccelStats& s = accel->stats();
+  EXPECT_EQ(s.primitive_count, 1000u);
+  EXPECT_GT(s.node_count, 0u);
+  EXPECT_GE(s.leaf_count, 1000u / 8);
+  EXPECT_EQ(s.device_bytes, s.node_count * sizeof(Bvh8Node) + s.leaf_count * sizeof(TriangleBlock));
+  EXPECT_GT(s.build_ms, 0.0);
+}
+
+}  // namespace
+}  // namespace rtcl::test
