@@ -10,6 +10,7 @@
 
 #include "ray_sets.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/render/ray_order.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 
 #ifdef RTCL_BENCH_HAVE_EMBREE
@@ -23,11 +24,16 @@ const char* ray_kind_name(RayKind kind) {
     case RayKind::primary: return "primary";
     case RayKind::shadow: return "shadow";
     case RayKind::diffuse: return "diffuse";
+    case RayKind::primary_tiled: return "primary-tiled";
+    case RayKind::shadow_morton: return "shadow-morton";
+    case RayKind::diffuse_morton: return "diffuse-morton";
   }
   return "?";
 }
 
-Query ray_kind_query(RayKind kind) { return kind == RayKind::shadow ? Query::any : Query::closest; }
+Query ray_kind_query(RayKind kind) {
+  return kind == RayKind::shadow || kind == RayKind::shadow_morton ? Query::any : Query::closest;
+}
 
 // Cameras and lights, in each file's own units and axes (all four are y-up).
 // bunny (0.16 units, faces +z) and dragon (14 units long, side view from +z):
@@ -125,6 +131,14 @@ std::shared_ptr<const BenchScene> load_scene(const SceneSpec& spec) {
   scene->diffuse.rays = std::move(secondary.diffuse);
   scene->shadow.reference = oracle.trace(Query::any, scene->shadow.rays);
   scene->diffuse.reference = oracle.trace(Query::closest, scene->diffuse.rays);
+  auto reorder = [](const RaySet& set, const std::vector<std::uint32_t>& order) {
+    return RaySet{gather<Ray>(set.rays, order), gather<Hit>(set.reference, order)};
+  };
+  auto size = static_cast<std::uint32_t>(scene->width);
+  scene->primary_tiled = reorder(scene->primary, tile_order(size, size));
+  Aabb bounds = scene->geometry.bounds();
+  scene->shadow_morton = reorder(scene->shadow, morton_order(scene->shadow.rays, bounds));
+  scene->diffuse_morton = reorder(scene->diffuse, morton_order(scene->diffuse.rays, bounds));
   scene->rays_ms = ms_since(start);
 
   if (const char* dir = std::getenv("RTCL_BENCH_DUMP"); dir && *dir)
@@ -172,6 +186,9 @@ const RaySet& BenchScene::rays(RayKind kind) const {
   switch (kind) {
     case RayKind::shadow: return shadow;
     case RayKind::diffuse: return diffuse;
+    case RayKind::primary_tiled: return primary_tiled;
+    case RayKind::shadow_morton: return shadow_morton;
+    case RayKind::diffuse_morton: return diffuse_morton;
     default: return primary;
   }
 }

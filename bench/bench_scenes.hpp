@@ -23,8 +23,16 @@ enum class RayKind {
   primary,  // camera rays through pixel centres; closest hit
   shadow,   // primary hit point -> the point light (t in [0, 1]); any hit
   diffuse,  // primary hit point, cosine-distributed around the facing normal; closest hit
+  // The same rays reordered for coherent packets (rtcl/render/ray_order.hpp):
+  primary_tiled,   // primary in 8x8 screen-tile order
+  shadow_morton,   // shadow in Morton order of (origin, direction)
+  diffuse_morton,  // diffuse in Morton order of (origin, direction)
 };
+// The sets every backend measures (scanline / pixel order) ...
 inline constexpr RayKind ray_kinds[] = {RayKind::primary, RayKind::shadow, RayKind::diffuse};
+// ... and the reordered ones, measured for rtcl's structures.
+inline constexpr RayKind ordered_ray_kinds[] = {RayKind::primary_tiled, RayKind::shadow_morton,
+                                                RayKind::diffuse_morton};
 const char* ray_kind_name(RayKind kind);
 Query ray_kind_query(RayKind kind);
 
@@ -80,6 +88,7 @@ struct BenchScene {
   Geometry geometry;  // validated
   int width = 0, height = 0;
   RaySet primary, shadow, diffuse;
+  RaySet primary_tiled, shadow_morton, diffuse_morton;  // the same rays and references, reordered
   std::string oracle;  // what answered the reference hits: "embree" or an accel name
   double load_ms = 0.0, rays_ms = 0.0;
 

@@ -1,6 +1,8 @@
 // rtcl's structures on the OpenCL device:
 //   build/<scene>/<accel>          host build + flatten time (stats().build_ms)
-//   trace/<scene>/<kind>/<accel>   kernel time of one launch over the ray set
+//   trace/<scene>/<kind>/<accel>   kernel time of one launch over the ray set; kinds:
+//     primary, shadow, diffuse (pixel order) and primary-tiled, shadow-morton,
+//     diffuse-morton (the same rays reordered for packets)
 // Kernel time comes from OpenCL event profiling (COMMAND_START .. COMMAND_END)
 // and is reported as manual time; a warm-up launch first absorbs PoCL's
 // compile-on-first-launch. Brute force traces a subset (brute_ray_limit()).
@@ -156,7 +158,9 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
     benchmark::RegisterBenchmark(("build/" + spec.name + "/" + accel).c_str(), build_benchmark, spec.name, accel)
         ->UseManualTime()
         ->Unit(benchmark::kMillisecond);
-  for (RayKind kind : ray_kinds)
+  std::vector<RayKind> kinds(std::begin(ray_kinds), std::end(ray_kinds));
+  kinds.insert(kinds.end(), std::begin(ordered_ray_kinds), std::end(ordered_ray_kinds));
+  for (RayKind kind : kinds)
     for (const std::string& accel : names)
       benchmark::RegisterBenchmark(
           ("trace/" + spec.name + "/" + ray_kind_name(kind) + "/" + accel).c_str(), trace_benchmark, spec.name,

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "rtcl/error.hpp"
+#include "support/error_of.hpp"
 #include "support/temp_dir.hpp"
 
 namespace rtcl::test {
@@ -16,15 +17,6 @@ namespace {
 
 std::span<const std::byte> bytes_of(const std::string& s) { return std::as_bytes(std::span(s.data(), s.size())); }
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(AtomicFile, WritesAndReplacesWholeFiles) {
   TempDir dir;

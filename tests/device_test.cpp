@@ -16,6 +16,7 @@
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
+#include "support/error_of.hpp"
 #include "support/fixtures.hpp"
 
 namespace rtcl::test {
@@ -45,17 +46,6 @@ class ScopedEnv {
   std::optional<std::string> old_;
 };
 
-// The message of the rtcl::Error that f throws; a failure when it throws none.
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an rtcl::Error";
-  return "";
-}
 
 std::string toggle_case(std::string s) {
   for (char& c : s) c = std::isupper(static_cast<unsigned char>(c)) ? std::tolower(c) : std::toupper(c);

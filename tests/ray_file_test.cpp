@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rtcl/error.hpp"
+#include "support/error_of.hpp"
 #include "support/temp_dir.hpp"
 
 namespace rtcl::test {
@@ -17,15 +18,6 @@ namespace {
 constexpr float inf = std::numeric_limits<float>::infinity();
 constexpr float nan = std::numeric_limits<float>::quiet_NaN();
 
-template <class F>
-std::string error_of(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 float float_at(const std::string& bytes, std::size_t offset) {
   unsigned char b[4];

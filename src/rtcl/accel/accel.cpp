@@ -5,8 +5,8 @@
 namespace rtcl {
 
 Accel::Accel(const Device& device, std::string name, const std::string& kernel_file, std::vector<std::string> defines,
-             AccelStats stats)
-    : device_(device), name_(std::move(name)), stats_(stats) {
+             AccelStats stats, std::size_t rays_per_work_item)
+    : device_(device), name_(std::move(name)), stats_(stats), rays_per_work_item_(rays_per_work_item) {
   cl::Program program = device_.program(kernel_file, defines);
   // "accel/bvh.cl" defines trace_closest_bvh and trace_any_bvh
   std::string stem = kernel_file.substr(kernel_file.rfind('/') + 1);
@@ -47,7 +47,8 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     // one per global size, so each new ray count would cost a code generation.
     const std::size_t group = 64;
     bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device()) >= group;
-    std::size_t global = fixed ? (ray_count + group - 1) / group * group : ray_count;
+    std::size_t items = (ray_count + rays_per_work_item_ - 1) / rays_per_work_item_;
+    std::size_t global = fixed ? (items + group - 1) / group * group : items;
     device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
                                          fixed ? cl::NDRange(group) : cl::NullRange,
                                          wait.empty() ? nullptr : &wait, &done);

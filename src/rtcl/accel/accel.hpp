@@ -49,8 +49,10 @@ class Accel {
                   const std::vector<cl::Event>& wait = {}) const;
 
  protected:
+  // rays_per_work_item: consecutive rays one work-item of the kernel traces
+  // (1, or 8 for a packet kernel); the launch covers ceil(ray_count / it).
   Accel(const Device& device, std::string name, const std::string& kernel_file, std::vector<std::string> defines,
-        AccelStats stats);
+        AccelStats stats, std::size_t rays_per_work_item = 1);
   // Sets the structure's kernel arguments, starting at argument `first`.
   virtual void set_structure_args(cl::Kernel& kernel, cl_uint first) const = 0;
 
@@ -58,6 +60,7 @@ class Accel {
   Device device_;
   std::string name_;
   AccelStats stats_;
+  std::size_t rays_per_work_item_;
   mutable cl::Kernel closest_, any_;
   mutable bool args_set_ = false;
 };

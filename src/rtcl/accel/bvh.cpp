@@ -232,9 +232,11 @@ class Flattener {
 
 class BvhAccel final : public Accel {
  public:
-  BvhAccel(const Device& device, std::string name, std::vector<std::string> defines, const Bvh8& bvh,
-           AccelStats stats)
-      : Accel(device, std::move(name), "accel/bvh.cl", std::move(defines), stats),
+  BvhAccel(const Device& device, std::string name, BvhTraversal traversal, std::vector<std::string> defines,
+           const Bvh8& bvh, AccelStats stats)
+      : Accel(device, std::move(name),
+              traversal == BvhTraversal::packet ? "accel/bvh_packet.cl" : "accel/bvh.cl", std::move(defines),
+              stats, traversal == BvhTraversal::packet ? RTCL_BLOCK_WIDTH : 1),
         nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
         primitives_(upload(device, bvh.blocks)) {}
 
@@ -286,7 +288,7 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
   stats.leaf_count = bvh.blocks.triangles.size() + bvh.blocks.spheres.size();
   std::vector<std::string> defines = primitive_defines(geometry);
   defines.push_back("RTCL_STACK_SIZE=" + std::to_string(bvh_kernel_stack_size(bvh.stack_size)));
-  return std::make_unique<BvhAccel>(device, std::move(name), std::move(defines), bvh, stats);
+  return std::make_unique<BvhAccel>(device, std::move(name), config.traversal, std::move(defines), bvh, stats);
 }
 
 std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry) {
@@ -297,6 +299,12 @@ std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geome
   BvhConfig config;
   config.builder = BvhBuilder::ploc;
   return make_bvh(device, geometry, config, "bvh-ploc");
+}
+
+std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry) {
+  BvhConfig config;
+  config.traversal = BvhTraversal::packet;
+  return make_bvh(device, geometry, config, "bvh-packet");
 }
 
 }  // namespace rtcl

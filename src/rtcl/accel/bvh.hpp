@@ -23,8 +23,15 @@ enum class BvhBuilder {
   ploc,  // bottom-up clustering (bvh_ploc.hpp)
 };
 
+enum class BvhTraversal {
+  single_ray,  // one ray per work-item, a node's 8 children in float8 lanes (kernels/accel/bvh.cl)
+  packet,      // 8 consecutive rays per work-item in float8 lanes (kernels/accel/bvh_packet.cl):
+               // same tree, same results; pays off only for coherent packets
+};
+
 struct BvhConfig {
   BvhBuilder builder = BvhBuilder::sah;
+  BvhTraversal traversal = BvhTraversal::single_ray;
   SahConfig sah;
   PlocConfig ploc;
   // Collapse: two leaves of one wide node share a block when their
@@ -75,9 +82,11 @@ std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size);
 std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config = {},
                                 std::string name = "bvh");
 
-// The registered structures: "bvh" (binned SAH, default config) and
-// "bvh-ploc" (PLOC, default config).
+// The registered structures: "bvh" (binned SAH, default config),
+// "bvh-ploc" (PLOC, default config) and "bvh-packet" (binned SAH, packet
+// traversal).
 std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry);
 std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry);
+std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry);
 
 }  // namespace rtcl

@@ -18,6 +18,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"brute", make_brute},
       {"bvh", make_bvh_sah},
       {"bvh-ploc", make_bvh_ploc},
+      {"bvh-packet", make_bvh_packet},
   };
   return entries;
 }

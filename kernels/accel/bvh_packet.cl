@@ -1,0 +1,300 @@
+/* 8-wide BVH traversal, one packet of 8 consecutive rays per work-item: the
+ * same BVH8 as accel/bvh.cl (same build, same node and block layout), but the
+ * float8 lanes hold the eight rays instead of a node's eight children
+ * (packet traversal, Wald, Slusallek, Benthin, Wagner 2001, "Interactive
+ * rendering with coherent ray tracing"). Per node, each child box is tested
+ * against the packet's rays at once; per leaf, each primitive is tested
+ * against them at once. The packet shares one stack; each entry carries the
+ * per-ray entry distances of its box, NaN for the rays that missed it, so
+ * that a popped entry is active exactly for the rays that entered its box
+ * before their current closest hit.
+ *
+ * Contract: rays 8p .. 8p+7 (those below ray_count) form packet p; any rays
+ * work (coherent ones, e.g. screen tiles or Morton order, are faster). Every
+ * ray gets exactly the arithmetic of accel/bvh.cl (intersect.h): the same
+ * slab distances and the same watertight edge functions, lane by lane, so
+ * closest-hit t is bit-identical to the single-ray kernel (the primitive may
+ * differ between two at exactly the same t). Any hit reports some hit.
+ *
+ * Stack bound: as in accel/bvh.cl (a node pushes at most its children and
+ * pops one), so the host's RTCL_STACK_SIZE is valid here too. */
+#include "shared/intersect.h"
+
+#ifndef RTCL_STACK_SIZE
+#define RTCL_STACK_SIZE 64
+#endif
+
+/* Per-packet constants: the TraceRay of each lane, in float8/int8 lanes.
+ * active: lanes with a traceable ray (trace_ray_setup's conditions). */
+typedef struct TracePacket {
+  float8 ox, oy, oz, tmin;
+  float8 ix, iy, iz;
+  int8 pos_x, pos_y, pos_z;  /* reciprocal direction >= 0: lower plane is the entry plane */
+  int8 kx1, kx2, ky1, ky2, kz1, kz2; /* kx == 1, kx == 2, ... (axis permutation) */
+  float8 sx, sy, sz;
+  float8 okx, oky, okz;
+  float8 dx, dy, dz;
+  int8 active;
+} TracePacket;
+
+/* Lane-wise a[k] for a per-lane axis index given as masks k == 1, k == 2. */
+inline float8 rtcl_pick_axis(float8 x, float8 y, float8 z, int8 k1, int8 k2) {
+  return select(select(x, y, k1), z, k2);
+}
+
+inline void packet_setup(global const Ray* rays, uint first, uint ray_count, TracePacket* p, float8* tmax) {
+  float lanes[8][8];  /* [field][lane] */
+  for (int l = 0; l < 8; ++l) {
+    uint i = first + (uint)l;
+    Ray r;
+    if (i < ray_count) {
+      r = rays[i];
+    } else { /* padding: an untraceable ray (zero direction) */
+      r.ox = r.oy = r.oz = r.dx = r.dy = r.dz = 0.0f;
+      r.tmin = 0.0f;
+      r.tmax = -1.0f;
+    }
+    lanes[0][l] = r.ox; lanes[1][l] = r.oy; lanes[2][l] = r.oz;
+    lanes[3][l] = r.dx; lanes[4][l] = r.dy; lanes[5][l] = r.dz;
+    lanes[6][l] = r.tmin; lanes[7][l] = r.tmax;
+  }
+  float8 ox = vload8(0, lanes[0]), oy = vload8(0, lanes[1]), oz = vload8(0, lanes[2]);
+  float8 dx = vload8(0, lanes[3]), dy = vload8(0, lanes[4]), dz = vload8(0, lanes[5]);
+  float8 tmin = vload8(0, lanes[6]);
+  *tmax = vload8(0, lanes[7]);
+  float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
+  /* kz = dominant axis, ties as in trace_ray_setup */
+  int8 kz = select(select((int8)(2), (int8)(1), ay > az), select((int8)(2), (int8)(0), ax > az), ax > ay);
+  float8 adk = select(select(az, ay, kz == 1), ax, kz == 0);
+  p->active = (adk > 0.0f) & (tmin <= *tmax) & !isnan(ox + oy + oz + dx + dy + dz);
+  int8 kx = select(kz + 1, (int8)(0), kz == 2);
+  int8 ky = select(kx + 1, (int8)(0), kx == 2);
+  float8 dkz = rtcl_pick_axis(dx, dy, dz, kz == 1, kz == 2);
+  int8 flip = dkz < 0.0f;
+  int8 tx = select(kx, ky, flip), ty = select(ky, kx, flip);
+  p->kx1 = tx == 1; p->kx2 = tx == 2;
+  p->ky1 = ty == 1; p->ky2 = ty == 2;
+  p->kz1 = kz == 1; p->kz2 = kz == 2;
+  p->ox = ox; p->oy = oy; p->oz = oz; p->tmin = tmin;
+  p->dx = dx; p->dy = dy; p->dz = dz;
+  p->ix = 1.0f / dx;
+  p->iy = 1.0f / dy;
+  p->iz = 1.0f / dz;
+  p->pos_x = p->ix >= 0.0f;
+  p->pos_y = p->iy >= 0.0f;
+  p->pos_z = p->iz >= 0.0f;
+  p->sz = 1.0f / dkz;
+  p->sx = rtcl_pick_axis(dx, dy, dz, p->kx1, p->kx2) / dkz;
+  p->sy = rtcl_pick_axis(dx, dy, dz, p->ky1, p->ky2) / dkz;
+  p->okx = rtcl_pick_axis(ox, oy, oz, p->kx1, p->kx2);
+  p->oky = rtcl_pick_axis(ox, oy, oz, p->ky1, p->ky2);
+  p->okz = rtcl_pick_axis(ox, oy, oz, p->kz1, p->kz2);
+}
+
+/* Closest-hit state of the packet, lane = ray: t_best as in HitState; the
+ * winning edge functions are kept and turned into (u, v) at the end, as
+ * intersect_triangles8 does for its winner. */
+typedef struct PacketHits {
+  float8 t_best, det, V, W;
+  int8 prim;
+} PacketHits;
+
+/* Child c's box against the packet over [tmin, t_best]: intersect_boxes8's
+ * arithmetic per lane (entry plane chosen by the lane's direction sign).
+ * Returns the entry distances, NaN where the ray misses the box. */
+inline float8 packet_box(global const Bvh8Node* node, int c, const TracePacket* p, float8 t_best, int8 mask) {
+  float lx = node->bounds[0][c], ly = node->bounds[1][c], lz = node->bounds[2][c];
+  float ux = node->bounds[3][c], uy = node->bounds[4][c], uz = node->bounds[5][c];
+  float8 tnx = (select((float8)(ux), (float8)(lx), p->pos_x) - p->ox) * p->ix;
+  float8 tny = (select((float8)(uy), (float8)(ly), p->pos_y) - p->oy) * p->iy;
+  float8 tnz = (select((float8)(uz), (float8)(lz), p->pos_z) - p->oz) * p->iz;
+  float8 tfx = (select((float8)(lx), (float8)(ux), p->pos_x) - p->ox) * p->ix;
+  float8 tfy = (select((float8)(ly), (float8)(uy), p->pos_y) - p->oy) * p->iy;
+  float8 tfz = (select((float8)(lz), (float8)(uz), p->pos_z) - p->oz) * p->iz;
+  float8 tn = rtcl_fmax8(tnx, rtcl_fmax8(tny, rtcl_fmax8(tnz, p->tmin)));
+  float8 tf = rtcl_fmin8(tfx, rtcl_fmin8(tfy, rtcl_fmin8(tfz, t_best)));
+  tn = tn - fabs(tn) * RTCL_SLAB_WIDEN;
+  tf = tf + fabs(tf) * RTCL_SLAB_WIDEN;
+  return select((float8)(NAN), tn, mask & (tn <= tf));
+}
+
+/* Triangle k of a block against the packet's rays in `mask`:
+ * intersect_triangles8's arithmetic per lane. Returns the lanes it hits in
+ * [tmin, t_best) and records those hits. */
+inline int8 packet_triangle(global const TriangleBlock* block, int k, const TracePacket* p, PacketHits* h,
+                            int8 mask) {
+  /* v[vertex][axis][lane]: vertex j's coordinates, permuted per ray */
+  float8 az = rtcl_pick_axis((float8)(block->v[0][0][k]), (float8)(block->v[0][1][k]), (float8)(block->v[0][2][k]), p->kz1, p->kz2) - p->okz;
+  float8 bz = rtcl_pick_axis((float8)(block->v[1][0][k]), (float8)(block->v[1][1][k]), (float8)(block->v[1][2][k]), p->kz1, p->kz2) - p->okz;
+  float8 cz = rtcl_pick_axis((float8)(block->v[2][0][k]), (float8)(block->v[2][1][k]), (float8)(block->v[2][2][k]), p->kz1, p->kz2) - p->okz;
+  float8 ax = rtcl_pick_axis((float8)(block->v[0][0][k]), (float8)(block->v[0][1][k]), (float8)(block->v[0][2][k]), p->kx1, p->kx2) - p->okx - p->sx * az;
+  float8 ay = rtcl_pick_axis((float8)(block->v[0][0][k]), (float8)(block->v[0][1][k]), (float8)(block->v[0][2][k]), p->ky1, p->ky2) - p->oky - p->sy * az;
+  float8 bx = rtcl_pick_axis((float8)(block->v[1][0][k]), (float8)(block->v[1][1][k]), (float8)(block->v[1][2][k]), p->kx1, p->kx2) - p->okx - p->sx * bz;
+  float8 by = rtcl_pick_axis((float8)(block->v[1][0][k]), (float8)(block->v[1][1][k]), (float8)(block->v[1][2][k]), p->ky1, p->ky2) - p->oky - p->sy * bz;
+  float8 cx = rtcl_pick_axis((float8)(block->v[2][0][k]), (float8)(block->v[2][1][k]), (float8)(block->v[2][2][k]), p->kx1, p->kx2) - p->okx - p->sx * cz;
+  float8 cy = rtcl_pick_axis((float8)(block->v[2][0][k]), (float8)(block->v[2][1][k]), (float8)(block->v[2][2][k]), p->ky1, p->ky2) - p->oky - p->sy * cz;
+  float8 U = rtcl_edge8(cx, cy, bx, by);
+  float8 V = rtcl_edge8(ax, ay, cx, cy);
+  float8 W = rtcl_edge8(bx, by, ax, ay);
+  int8 inside = ((U >= 0.0f) & (V >= 0.0f) & (W >= 0.0f)) | ((U <= 0.0f) & (V <= 0.0f) & (W <= 0.0f));
+  float8 det = U + V + W;
+  float8 T = p->sz * (U * az + V * bz + W * cz);
+  float8 t = T / det;
+  int8 ok = mask & inside & (det != 0.0f) & (t >= p->tmin) & (t < h->t_best);
+  if (!rtcl_any8(ok)) return ok;
+  h->t_best = select(h->t_best, t, ok);
+  h->det = select(h->det, det, ok);
+  h->V = select(h->V, V, ok);
+  h->W = select(h->W, W, ok);
+  h->prim = select(h->prim, (int8)(block->prim[k]), ok);
+  return ok;
+}
+
+#ifdef RTCL_HAS_SPHERES
+/* Sphere k of a block against the packet: intersect_spheres8's arithmetic
+ * per lane (Haines et al., Ray Tracing Gems ch. 7). */
+inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePacket* p, PacketHits* h, int8 mask) {
+  float r = block->r[k];
+  float8 fx = p->ox - block->cx[k];
+  float8 fy = p->oy - block->cy[k];
+  float8 fz = p->oz - block->cz[k];
+  float8 a = p->dx * p->dx + p->dy * p->dy + p->dz * p->dz;
+  float8 b = -(fx * p->dx + fy * p->dy + fz * p->dz);
+  float8 kk = b / a;
+  float8 lx = fx + kk * p->dx, ly = fy + kk * p->dy, lz = fz + kk * p->dz;
+  float8 disc = a * (r * r - (lx * lx + ly * ly + lz * lz));
+  int8 real = disc >= 0.0f;
+  float8 c = fx * fx + fy * fy + fz * fz - r * r;
+  float8 q = b + copysign(sqrt(fmax(disc, 0.0f)), b);
+  float8 t0 = c / q, t1 = q / a;
+  float8 tn = fmin(t0, t1), tf = fmax(t0, t1);
+  int8 ok_n = real & (tn >= p->tmin) & (tn < h->t_best);
+  int8 ok_f = real & (tf >= p->tmin) & (tf < h->t_best);
+  float8 t = select(tf, tn, ok_n);
+  int8 ok = mask & (ok_n | ok_f);
+  if (!rtcl_any8(ok)) return ok;
+  h->t_best = select(h->t_best, t, ok);
+  h->det = select(h->det, (float8)(1.0f), ok);
+  h->V = select(h->V, (float8)(0.0f), ok);
+  h->W = select(h->W, (float8)(0.0f), ok);
+  h->prim = select(h->prim, (int8)(block->prim[k]), ok);
+  return ok;
+}
+#endif
+
+/* Traverses the packet. any_hit: a ray leaves the packet at its first hit;
+ * the traversal ends when every ray has. */
+__attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketHits* h, global const Bvh8Node* nodes,
+                                                   global const TriangleBlock* triangles,
+                                                   global const SphereBlock* spheres, const int any_hit) {
+  float8 stack_t[RTCL_STACK_SIZE]; /* entry distances of stack_ref's box, NaN: ray not in it */
+  int stack_ref[RTCL_STACK_SIZE];
+  float stack_key[RTCL_STACK_SIZE]; /* nearest entry distance over the packet: visiting order */
+  int sp = 0;
+  int ref = 0;
+  int8 alive = p->active; /* any hit: rays still looking */
+  int8 mask = alive;
+  for (;;) {
+    if (ref >= 0) {
+      global const Bvh8Node* node = nodes + ref;
+      int base = sp;
+      for (int c = 0; c < 8; ++c) {
+        int child = node->child[c];
+        if (child == RTCL_CHILD_EMPTY) continue;
+        float8 tn = packet_box(node, c, p, h->t_best, mask);
+        int8 in = tn == tn;
+        if (!rtcl_any8(in)) continue;
+        float key = rtcl_min8(select((float8)(INFINITY), tn, in));
+        /* insertion into [base, sp) kept sorted by decreasing key */
+        int j = sp++;
+        while (!any_hit && j > base && stack_key[j - 1] < key) {
+          stack_key[j] = stack_key[j - 1];
+          stack_t[j] = stack_t[j - 1];
+          stack_ref[j] = stack_ref[j - 1];
+          --j;
+        }
+        stack_key[j] = key;
+        stack_t[j] = tn;
+        stack_ref[j] = child;
+      }
+    } else {
+      int leaf = ~ref;
+#ifdef RTCL_HAS_SPHERES
+      if (leaf & 1) {
+        global const SphereBlock* block = spheres + (leaf >> 1);
+        for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
+          if (block->prim[k] < 0) continue;
+          int8 hit = packet_sphere(block, k, p, h, mask);
+          if (any_hit) {
+            alive &= ~hit;
+            mask &= ~hit;
+          }
+        }
+      } else
+#endif
+      {
+        global const TriangleBlock* block = triangles + (leaf >> 1);
+        for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
+          if (block->prim[k] < 0) continue;
+          int8 hit = packet_triangle(block, k, p, h, mask);
+          if (any_hit) {
+            alive &= ~hit;
+            mask &= ~hit;
+          }
+        }
+      }
+      if (any_hit && !rtcl_any8(alive)) return;
+    }
+    /* pop the next entry some ray still needs: entered before its best hit */
+    for (;;) {
+      if (sp == 0) return;
+      --sp;
+      mask = alive & (stack_t[sp] <= h->t_best);
+      if (rtcl_any8(mask)) break;
+    }
+    ref = stack_ref[sp];
+  }
+}
+
+inline void packet_trace(global const Ray* rays, global Hit* hits, uint ray_count, global const Bvh8Node* nodes,
+                         global const TriangleBlock* triangles, global const SphereBlock* spheres, int any_hit) {
+  uint first = get_global_id(0) * 8u;
+  if (first >= ray_count) return;
+  TracePacket p;
+  float8 tmax;
+  packet_setup(rays, first, ray_count, &p, &tmax);
+  PacketHits h;
+  h.t_best = nextafter(tmax, (float8)(INFINITY));
+  h.det = (float8)(1.0f);
+  h.V = h.W = (float8)(0.0f);
+  h.prim = (int8)(-1);
+  if (rtcl_any8(p.active)) bvh_packet_traverse(&p, &h, nodes, triangles, spheres, any_hit);
+  float inv_det[8], V[8], W[8], t[8];
+  int prim[8];
+  vstore8(h.t_best, 0, t);
+  vstore8(h.det, 0, inv_det);
+  vstore8(h.V, 0, V);
+  vstore8(h.W, 0, W);
+  vstore8(h.prim, 0, prim);
+  for (uint l = 0; l < 8u && first + l < ray_count; ++l) {
+    Hit out;
+    float id = 1.0f / inv_det[l];
+    out.t = prim[l] < 0 ? INFINITY : t[l];
+    out.u = V[l] * id;
+    out.v = W[l] * id;
+    out.prim = prim[l];
+    hits[first + l] = out;
+  }
+}
+
+kernel void trace_closest_bvh_packet(global const Ray* rays, global Hit* hits, uint ray_count,
+                                     global const Bvh8Node* nodes, global const TriangleBlock* triangles,
+                                     global const SphereBlock* spheres) {
+  packet_trace(rays, hits, ray_count, nodes, triangles, spheres, 0);
+}
+
+kernel void trace_any_bvh_packet(global const Ray* rays, global Hit* hits, uint ray_count,
+                                 global const Bvh8Node* nodes, global const TriangleBlock* triangles,
+                                 global const SphereBlock* spheres) {
+  packet_trace(rays, hits, ray_count, nodes, triangles, spheres, 1);
+}

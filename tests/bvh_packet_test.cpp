@@ -1,0 +1,164 @@
+// The packet traversal ("bvh-packet", kernels/accel/bvh_packet.cl): 8
+// consecutive rays per work-item. Its contract is the single-ray kernel's
+// answers: the closest t bit for bit (same slab and edge arithmetic per
+// lane), the same occlusion for any hit, whatever the packets hold —
+// coherent tiles, Morton-ordered secondary rays, random rays, invalid rays
+// beside valid ones, and a ray count that is not a multiple of 8. The
+// generic suites (adversarial_test, device_test, render_test) cover it
+// through accel_names().
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+
+#include "rtcl/accel/bvh.hpp"
+#include "rtcl/render/ray_order.hpp"
+#include "rtcl/scene/mesh_io.hpp"
+#include "support/fixtures.hpp"
+#include "support/reference.hpp"
+
+namespace rtcl::test {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// Pinhole camera rays, row-major, looking at the geometry from +z.
+std::vector<Ray> camera_rays(const Geometry& g, std::uint32_t width, std::uint32_t height) {
+  Aabb box = g.bounds();
+  glm::vec3 centre = box.center(), extent = box.extent();
+  glm::vec3 eye = centre + glm::vec3(0.1f * extent.x, 0.2f * extent.y, 1.5f * std::max(extent.x, extent.y));
+  std::vector<Ray> rays;
+  for (std::uint32_t y = 0; y < height; ++y)
+    for (std::uint32_t x = 0; x < width; ++x) {
+      glm::vec3 target = centre + glm::vec3((static_cast<float>(x) + 0.5f) / static_cast<float>(width) - 0.5f,
+                                            0.5f - (static_cast<float>(y) + 0.5f) / static_cast<float>(height),
+                                            0.0f) * std::max(extent.x, extent.y) * 1.2f;
+      glm::vec3 d = glm::normalize(target - eye);
+      rays.push_back({eye.x, eye.y, eye.z, d.x, d.y, d.z, 0.0f, kInf});
+    }
+  return rays;
+}
+
+// Diffuse-like bounce rays from the closest hits of `primary`.
+std::vector<Ray> bounce_rays(const Geometry& g, const std::vector<Ray>& primary, const std::vector<Hit>& hits,
+                             std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  float offset = 1e-4f * glm::length(g.bounds().extent());
+  std::vector<Ray> rays;
+  for (std::size_t i = 0; i < primary.size(); ++i) {
+    if (hits[i].prim < 0) continue;
+    const Ray& r = primary[i];
+    glm::vec3 p = glm::vec3(r.ox, r.oy, r.oz) + hits[i].t * glm::vec3(r.dx, r.dy, r.dz);
+    glm::vec3 d = glm::normalize(glm::vec3(normal(rng), normal(rng), normal(rng)));
+    if (glm::dot(d, glm::vec3(r.dx, r.dy, r.dz)) > 0.0f) d = -d;
+    p += offset * d;
+    rays.push_back({p.x, p.y, p.z, d.x, d.y, d.z, 0.0f, kInf});
+  }
+  return rays;
+}
+
+// Closest t bit for bit and hit/miss for any hit, packet against single ray.
+void expect_same_as_single_ray(const Accel& single, const Accel& packet, const std::vector<Ray>& rays,
+                               const char* what) {
+  for (Query q : {Query::closest, Query::any}) {
+    auto expected = run_query(single, rays, q);
+    auto got = run_query(packet, rays, q);
+    std::size_t differ = 0, first = rays.size();
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      bool same = q == Query::closest ? std::memcmp(&expected[i].t, &got[i].t, sizeof(float)) == 0
+                                      : (expected[i].prim >= 0) == (got[i].prim >= 0);
+      if (!same && differ++ == 0) first = i;
+    }
+    EXPECT_EQ(differ, 0u) << what << (q == Query::closest ? " closest" : " any") << ": first at ray " << first
+                          << " of " << rays.size();
+  }
+}
+
+Geometry bunny() {
+  Geometry g = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
+  validate(g);
+  return g;
+}
+
+TEST(BvhPacket, IsRegistered) {
+  auto names = accel_names();
+  EXPECT_NE(std::find(names.begin(), names.end(), "bvh-packet"), names.end());
+}
+
+TEST(BvhPacket, MatchesSingleRayInEveryOrderOnBunny) {
+  Geometry g = bunny();
+  auto single = make_accel(test_device(), "bvh", g);
+  auto packet = make_accel(test_device(), "bvh-packet", g);
+  EXPECT_EQ(packet->name(), "bvh-packet");
+  EXPECT_EQ(packet->stats().node_count, single->stats().node_count);  // the same tree
+  std::vector<Ray> rows = camera_rays(g, 256, 256);
+  std::vector<Ray> tiled = gather<Ray>(rows, tile_order(256, 256));
+  expect_same_as_single_ray(*single, *packet, rows, "primary, row order");
+  expect_same_as_single_ray(*single, *packet, tiled, "primary, tile order");
+  std::vector<Ray> bounces = bounce_rays(g, tiled, run_query(*single, tiled, Query::closest), 5);
+  ASSERT_GT(bounces.size(), 5000u);
+  expect_same_as_single_ray(*single, *packet, bounces, "bounce, hit order");
+  expect_same_as_single_ray(*single, *packet, gather<Ray>(bounces, morton_order(bounces, g.bounds())),
+                            "bounce, Morton order");
+}
+
+TEST(BvhPacket, MatchesReferenceOnIncoherentRaysWithSpheres) {
+  Geometry g = random_soup(1500, 61);
+  std::mt19937 rng(62);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int i = 0; i < 150; ++i) g.spheres.push_back({{unit(rng), unit(rng), unit(rng)}, 0.005f + 0.03f * unit(rng)});
+  auto packet = make_accel(test_device(), "bvh-packet", g);
+  std::vector<Ray> rays = random_rays(g, 1499, 63);  // not a multiple of 8
+  for (Query q : {Query::closest, Query::any}) {
+    std::size_t failures = 0;
+    auto report = judge_all(g, rays, run_query(*packet, rays, q), q, &failures);
+    EXPECT_EQ(failures, 0u) << (q == Query::closest ? "closest: " : "any: ") << (report.empty() ? "" : report[0]);
+  }
+  auto single = make_accel(test_device(), "bvh", g);
+  expect_same_as_single_ray(*single, *packet, rays, "soup with spheres");
+}
+
+// Invalid rays share packets with valid ones; counts 1 .. 17 leave partial
+// packets; the hits past ray_count stay untouched.
+TEST(BvhPacket, PartialPacketsAndInvalidRaysInAPacket) {
+  Geometry g = random_soup(300, 71);
+  auto packet = make_accel(test_device(), "bvh-packet", g);
+  auto single = make_accel(test_device(), "bvh", g);
+  std::vector<Ray> rays = random_rays(g, 24, 72);
+  rays[1].dx = kNaN;
+  rays[3].dx = rays[3].dy = rays[3].dz = 0.0f;
+  rays[4].tmin = 2.0f;
+  rays[4].tmax = 1.0f;
+  rays[6].oz = kInf;
+  expect_same_as_single_ray(*single, *packet, rays, "mixed packet");
+  const Device& device = test_device();
+  for (std::size_t count = 1; count <= 17; ++count) {
+    SCOPED_TRACE("ray_count " + std::to_string(count));
+    cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), "test rays");
+    std::vector<Hit> sentinel(rays.size(), Hit{-7.0f, -7.0f, -7.0f, -7});
+    cl::Buffer hit_buffer = device.upload(sentinel.data(), sentinel.size() * sizeof(Hit), "test hits");
+    std::vector<Hit> hits(rays.size());
+    packet->trace(Query::closest, ray_buffer, hit_buffer, count).wait();
+    device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data());
+    std::vector<Ray> prefix(rays.begin(), rays.begin() + static_cast<std::ptrdiff_t>(count));
+    auto expected = run_query(*single, prefix, Query::closest);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      if (i < count) {
+        EXPECT_EQ(hits[i].prim >= 0, expected[i].prim >= 0) << "ray " << i;
+        if (expected[i].prim >= 0) EXPECT_EQ(hits[i].t, expected[i].t) << "ray " << i;
+      } else {
+        EXPECT_EQ(hits[i].prim, -7) << "hit " << i << " written past ray_count";
+      }
+    }
+    for (int bad : {1, 3, 4, 6})
+      if (static_cast<std::size_t>(bad) < count) EXPECT_EQ(hits[bad].prim, -1) << "invalid ray " << bad;
+  }
+}
+
+}  // namespace
+}  // namespace rtcl::test
