@@ -17,6 +17,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rtcl/accel/accel.hpp"
@@ -58,11 +59,14 @@ struct RunOptions {
   bool judge = true;  // also compare with the double-precision reference
 };
 
-// Runs both queries of every structure on the rays; each answer must agree
-// with brute force bit for bit (see the file comment), pass the reference
-// judge, and pass `check`. The judge's verdict depends only on the answer, so
-// brute force's answers are judged in full and another structure's only
-// where they differ (same t, another primitive sharing an edge or vertex).
+// Runs both queries of every structure on the rays, and again as a
+// Coherence::coherent call where that selects another kernel (the
+// adversarial rays are no coherent packets, but the answers may not depend
+// on the promise); each answer must agree with brute force bit for bit (see
+// the file comment), pass the reference judge, and pass `check`. The judge's
+// verdict depends only on the answer, so brute force's answers are judged in
+// full and another structure's only where they differ (same t, another
+// primitive sharing an edge or vertex).
 void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, const Check& check,
                     RunOptions options = {}) {
   const Device& device = test_device();
@@ -70,10 +74,15 @@ void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, cons
   std::vector<Hit> brute_hits[2] = {run_query(*brute, rays, Query::closest), run_query(*brute, rays, Query::any)};
   for (const std::string& name : accel_names()) {
     auto accel = name == "brute" ? nullptr : make_accel(device, name, geometry);
-    for (Query query : {Query::closest, Query::any}) {
-      SCOPED_TRACE(name + " " + query_name(query) + " on " + geometry.source);
+    std::vector<std::pair<Coherence, Query>> calls = {{Coherence::incoherent, Query::closest},
+                                                      {Coherence::incoherent, Query::any}};
+    if (accel && accel->rays_per_work_item(Coherence::coherent) != accel->rays_per_work_item(Coherence::incoherent))
+      calls.insert(calls.end(), {{Coherence::coherent, Query::closest}, {Coherence::coherent, Query::any}});
+    for (auto [coherence, query] : calls) {
+      SCOPED_TRACE(name + (coherence == Coherence::coherent ? " coherent " : " ") + query_name(query) + " on " +
+                   geometry.source);
       const std::vector<Hit>& expected = brute_hits[query == Query::closest ? 0 : 1];
-      std::vector<Hit> hits = accel ? run_query(*accel, rays, query) : expected;
+      std::vector<Hit> hits = accel ? run_query(*accel, rays, query, coherence) : expected;
       std::size_t disagreements = 0, failures = 0;
       std::string first, first_failure;
       for (std::size_t i = 0; i < rays.size(); ++i) {

@@ -1,11 +1,12 @@
-// The packet traversal ("bvh-packet", kernels/accel/bvh_packet.cl): 8
-// consecutive rays per work-item. Its contract is the single-ray kernel's
-// answers: the closest t bit for bit (same slab and edge arithmetic per
-// lane), the same occlusion for any hit, whatever the packets hold —
+// The packet traversal (kernels/accel/bvh_packet.cl): 8 consecutive rays
+// per work-item, used by "bvh-packet" for every call and by "bvh" and
+// "bvh-ploc" for Coherence::coherent calls. Its contract is the single-ray
+// kernel's answers: the closest t bit for bit (same slab and edge arithmetic
+// per lane), the same occlusion for any hit, whatever the packets hold —
 // coherent tiles, Morton-ordered secondary rays, random rays, invalid rays
 // beside valid ones, and a ray count that is not a multiple of 8. The
 // generic suites (adversarial_test, device_test, render_test) cover it
-// through accel_names().
+// through accel_names() and coherent calls.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/render/ray_order.hpp"
@@ -62,12 +64,13 @@ std::vector<Ray> bounce_rays(const Geometry& g, const std::vector<Ray>& primary,
   return rays;
 }
 
-// Closest t bit for bit and hit/miss for any hit, packet against single ray.
+// Closest t bit for bit and hit/miss for any hit, packet against single ray
+// (`packet` traced with `coherence`, `single` incoherent).
 void expect_same_as_single_ray(const Accel& single, const Accel& packet, const std::vector<Ray>& rays,
-                               const char* what) {
+                               const char* what, Coherence coherence = Coherence::incoherent) {
   for (Query q : {Query::closest, Query::any}) {
     auto expected = run_query(single, rays, q);
-    auto got = run_query(packet, rays, q);
+    auto got = run_query(packet, rays, q, coherence);
     std::size_t differ = 0, first = rays.size();
     for (std::size_t i = 0; i < rays.size(); ++i) {
       bool same = q == Query::closest ? std::memcmp(&expected[i].t, &got[i].t, sizeof(float)) == 0
@@ -88,6 +91,31 @@ Geometry bunny() {
 TEST(BvhPacket, IsRegistered) {
   auto names = accel_names();
   EXPECT_NE(std::find(names.begin(), names.end(), "bvh-packet"), names.end());
+}
+
+// Which kernel a call gets: packets for coherent calls where the structure
+// has a packet kernel, for every call on "bvh-packet", else one ray.
+TEST(BvhPacket, CoherenceSelectsTheKernel) {
+  Geometry g = random_soup(200, 81);
+  for (const std::string& name : accel_names()) {
+    SCOPED_TRACE(name);
+    auto accel = make_accel(test_device(), name, g);
+    bool bvh = name.rfind("bvh", 0) == 0;
+    EXPECT_EQ(accel->rays_per_work_item(Coherence::incoherent), name == "bvh-packet" ? 8u : 1u);
+    EXPECT_EQ(accel->rays_per_work_item(Coherence::coherent), bvh ? 8u : 1u);
+  }
+}
+
+TEST(BvhPacket, CoherentCallsMatchIncoherentOnesOnBunny) {
+  Geometry g = bunny();
+  for (const char* name : {"bvh", "bvh-ploc"}) {
+    SCOPED_TRACE(name);
+    auto accel = make_accel(test_device(), name, g);
+    std::vector<Ray> tiled = gather<Ray>(camera_rays(g, 128, 128), tile_order(128, 128));
+    expect_same_as_single_ray(*accel, *accel, tiled, "primary, tile order", Coherence::coherent);
+    std::vector<Ray> bounces = bounce_rays(g, tiled, run_query(*accel, tiled, Query::closest), 9);
+    expect_same_as_single_ray(*accel, *accel, bounces, "bounce, hit order", Coherence::coherent);
+  }
 }
 
 TEST(BvhPacket, MatchesSingleRayInEveryOrderOnBunny) {

@@ -142,6 +142,28 @@ TEST(Cli, TraceMatchesTheReference) {
   }
 }
 
+// --coherent: the default structure traces 8-ray packets; the answers stay
+// the reference's.
+TEST(Cli, CoherentTraceUsesPacketsAndMatchesTheReference) {
+  Inputs in;
+  Geometry g = load_mesh(in.mesh).geometry;
+  for (bool any : {false, true}) {
+    std::vector<std::string> args = {"trace", in.mesh, in.rays, "-o", "out.hits", "--coherent"};
+    if (any) args.push_back("--any");
+    CliRun run = run_cli(in.dir, args);
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_NE(run.out.find("8-ray packets"), std::string::npos) << run.out;
+    std::vector<Hit> hits = read_hits(in.dir.file("out.hits"));
+    ASSERT_EQ(hits.size(), in.ray_list.size());
+    std::size_t failures = 0;
+    auto report = judge_all(g, in.ray_list, hits, any ? Query::any : Query::closest, &failures);
+    EXPECT_EQ(failures, 0u) << (report.empty() ? "" : report[0]) << " (any " << any << ")";
+  }
+  CliRun plain = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits"});
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_NE(plain.out.find("one ray per work-item"), std::string::npos) << plain.out;
+}
+
 TEST(Cli, EmptyRayFileWritesAnEmptyHitFile) {
   Inputs in;
   in.dir.write("none.rays", "");

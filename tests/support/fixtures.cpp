@@ -55,13 +55,13 @@ std::vector<Ray> random_rays(const Geometry& geometry, std::size_t count, std::u
   return rays;
 }
 
-std::vector<Hit> run_query(const Accel& accel, const std::vector<Ray>& rays, Query query) {
+std::vector<Hit> run_query(const Accel& accel, const std::vector<Ray>& rays, Query query, Coherence coherence) {
   const Device& device = accel.device();
   cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), "test rays");
   cl::Buffer hit_buffer = device.allocate(rays.size() * sizeof(Hit), "test hits");
   std::vector<Hit> hits(rays.size());
   with_cl_errors([&] {
-    cl::Event done = accel.trace(query, ray_buffer, hit_buffer, rays.size());
+    cl::Event done = accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence);
     std::vector<cl::Event> wait{done};
     device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data(), &wait);
   });

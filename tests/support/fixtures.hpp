@@ -28,7 +28,8 @@ Geometry random_soup(std::size_t count, std::uint32_t seed, float size = 0.05f, 
 // points inside its bounds.
 std::vector<Ray> random_rays(const Geometry& geometry, std::size_t count, std::uint32_t seed);
 
-// Uploads rays, runs the query, returns the hits.
-std::vector<Hit> run_query(const Accel& accel, const std::vector<Ray>& rays, Query query);
+// Uploads rays, runs the query with that coherence promise, returns the hits.
+std::vector<Hit> run_query(const Accel& accel, const std::vector<Ray>& rays, Query query,
+                           Coherence coherence = Coherence::incoherent);
 
 }  // namespace rtcl::test

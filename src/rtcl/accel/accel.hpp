@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -17,6 +18,22 @@ namespace rtcl {
 enum class Query {
   closest,  // nearest hit in [tmin, tmax]
   any,      // some hit in [tmin, tmax] (occlusion); t and prim of that hit
+};
+
+// What a trace call promises about the order of its rays; it picks the
+// kernel (Accel::rays_per_work_item), never the answer: the closest hit's t
+// is the same either way (on an exact tie of t, or for Query::any, which of
+// the hit primitives is reported may differ).
+enum class Coherence {
+  // No promise: diffuse and glossy bounces, reflections and refractions,
+  // rays in arbitrary order. Each work-item traces one ray.
+  incoherent,
+  // Each consecutive group of 8 rays (0-7, 8-15, ...) is alike: nearby
+  // origins, similar directions. E.g. camera rays in 8x8 screen-tile order
+  // (a group is one tile row), shadow rays towards one light in pixel, tile
+  // or Morton order (render/ray_order.hpp). A structure with a packet kernel
+  // traces each group in one work-item; the others treat it as incoherent.
+  coherent,
 };
 
 struct AccelStats {
@@ -38,31 +55,56 @@ class Accel {
   const AccelStats& stats() const { return stats_; }
   const Device& device() const { return device_; }
 
+  // Consecutive rays one work-item traces in calls of this coherence: 1
+  // (single-ray kernel) or 8 (packet kernel).
+  std::size_t rays_per_work_item(Coherence coherence) const;
+
   // Enqueues the query for rays[0 .. ray_count) into hits[0 .. ray_count) on
-  // the device's queue after `wait`; returns the kernel's event. Throws Error
-  // when a buffer is smaller than ray_count records. Not thread-safe per Accel.
+  // the device's queue after `wait`; returns the kernel's event. `coherence`
+  // is the caller's promise about the ray order (see Coherence); a wrong
+  // promise costs speed, never correctness. Throws Error when a buffer is
+  // smaller than ray_count records. Not thread-safe per Accel.
   cl::Event trace(Query query, const cl::Buffer& rays, const cl::Buffer& hits, std::size_t ray_count,
-                  const std::vector<cl::Event>& wait = {}) const;
+                  const std::vector<cl::Event>& wait = {}, Coherence coherence = Coherence::incoherent) const;
   // The same on a caller's raw buffers (retained for the call, not owned):
   // for applications on the OpenCL C API.
   cl::Event trace(Query query, cl_mem rays, cl_mem hits, std::size_t ray_count,
-                  const std::vector<cl::Event>& wait = {}) const;
+                  const std::vector<cl::Event>& wait = {}, Coherence coherence = Coherence::incoherent) const;
 
  protected:
-  // rays_per_work_item: consecutive rays one work-item of the kernel traces
-  // (1, or 8 for a packet kernel); the launch covers ceil(ray_count / it).
-  Accel(const Device& device, std::string name, const std::string& kernel_file, std::vector<std::string> defines,
-        AccelStats stats, std::size_t rays_per_work_item = 1);
+  // The trace kernels of one kernel file: "accel/bvh.cl" defines
+  // trace_closest_bvh and trace_any_bvh. Each work-item traces
+  // rays_per_work_item consecutive rays (1, or 8 for a packet kernel); a
+  // launch covers ceil(ray_count / rays_per_work_item) work-items.
+  struct TraceKernels {
+    std::string file;
+    std::size_t rays_per_work_item = 1;
+  };
+  // `incoherent` serves Coherence::incoherent calls, and coherent ones too
+  // when `coherent` is absent. Both are built with `defines`; `incoherent`
+  // here, `coherent` at the first coherent call (a caller that never makes
+  // one never pays its build).
+  Accel(const Device& device, std::string name, TraceKernels incoherent, std::optional<TraceKernels> coherent,
+        std::vector<std::string> defines, AccelStats stats);
   // Sets the structure's kernel arguments, starting at argument `first`.
   virtual void set_structure_args(cl::Kernel& kernel, cl_uint first) const = 0;
 
  private:
+  struct KernelSet {
+    cl::Kernel closest, any;
+    std::size_t rays_per_work_item = 1;
+    bool args_set = false;  // set_structure_args done (at the set's first trace)
+  };
+  KernelSet make_kernels(const TraceKernels& kernels) const;
+  KernelSet& kernels_for(Coherence coherence) const;
+
   Device device_;
   std::string name_;
   AccelStats stats_;
-  std::size_t rays_per_work_item_;
-  mutable cl::Kernel closest_, any_;
-  mutable bool args_set_ = false;
+  std::vector<std::string> defines_;
+  std::optional<TraceKernels> coherent_spec_;
+  mutable KernelSet incoherent_;
+  mutable std::optional<KernelSet> coherent_;  // built from coherent_spec_ at the first coherent call
 };
 
 // Names make_accel accepts, in the order benchmarks list them.

@@ -13,7 +13,7 @@ namespace {
 class BruteAccel final : public Accel {
  public:
   BruteAccel(const Device& device, const Geometry& geometry, PrimitiveBlocks blocks, AccelStats stats)
-      : Accel(device, "brute", "accel/brute.cl", primitive_defines(geometry), stats),
+      : Accel(device, "brute", {"accel/brute.cl"}, std::nullopt, primitive_defines(geometry), stats),
         primitives_(upload(device, blocks)),
         triangle_blocks_(static_cast<cl_uint>(blocks.triangles.size())),
         sphere_blocks_(static_cast<cl_uint>(blocks.spheres.size())) {}

@@ -231,12 +231,14 @@ class Flattener {
 };
 
 class BvhAccel final : public Accel {
+  static inline const TraceKernels kPacket{"accel/bvh_packet.cl", RTCL_BLOCK_WIDTH};
+
  public:
   BvhAccel(const Device& device, std::string name, BvhTraversal traversal, std::vector<std::string> defines,
            const Bvh8& bvh, AccelStats stats)
       : Accel(device, std::move(name),
-              traversal == BvhTraversal::packet ? "accel/bvh_packet.cl" : "accel/bvh.cl", std::move(defines),
-              stats, traversal == BvhTraversal::packet ? RTCL_BLOCK_WIDTH : 1),
+              traversal == BvhTraversal::packet ? kPacket : TraceKernels{"accel/bvh.cl"},
+              traversal == BvhTraversal::packet ? std::nullopt : std::optional(kPacket), std::move(defines), stats),
         nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
         primitives_(upload(device, bvh.blocks)) {}
 
