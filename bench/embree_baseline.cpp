@@ -47,20 +47,26 @@ void check_embree(const char* what) {
 
 constexpr std::size_t block_rays = 1024;  // rays a thread takes from the shared counter at once
 
+RTCRay to_embree(const Ray& r) {
+  RTCRay ray;
+  ray.org_x = r.ox, ray.org_y = r.oy, ray.org_z = r.oz;
+  ray.dir_x = r.dx, ray.dir_y = r.dy, ray.dir_z = r.dz;
+  ray.tnear = r.tmin;
+  ray.tfar = r.tmax;
+  ray.time = 0.0f;
+  ray.mask = ~0u;
+  ray.id = 0;
+  ray.flags = 0;
+  return ray;
+}
+
 void closest(RTCScene scene, const Ray* rays, Hit* hits, std::size_t begin, std::size_t end) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   for (std::size_t i = begin; i < end; ++i) {
     const Ray& r = rays[i];
     RTCRayHit rh;
-    rh.ray.org_x = r.ox, rh.ray.org_y = r.oy, rh.ray.org_z = r.oz;
-    rh.ray.dir_x = r.dx, rh.ray.dir_y = r.dy, rh.ray.dir_z = r.dz;
-    rh.ray.tnear = r.tmin;
-    rh.ray.tfar = r.tmax;
-    rh.ray.time = 0.0f;
-    rh.ray.mask = ~0u;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
+    rh.ray = to_embree(r);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene, &context, &rh);
@@ -76,15 +82,7 @@ void occluded(RTCScene scene, const Ray* rays, Hit* hits, std::size_t begin, std
   rtcInitIntersectContext(&context);
   for (std::size_t i = begin; i < end; ++i) {
     const Ray& r = rays[i];
-    RTCRay ray;
-    ray.org_x = r.ox, ray.org_y = r.oy, ray.org_z = r.oz;
-    ray.dir_x = r.dx, ray.dir_y = r.dy, ray.dir_z = r.dz;
-    ray.tnear = r.tmin;
-    ray.tfar = r.tmax;
-    ray.time = 0.0f;
-    ray.mask = ~0u;
-    ray.id = 0;
-    ray.flags = 0;
+    RTCRay ray = to_embree(r);
     rtcOccluded1(scene, &context, &ray);
     // rtcOccluded1 sets tfar = -inf when the ray is blocked.
     if (ray.tfar == -std::numeric_limits<float>::infinity())

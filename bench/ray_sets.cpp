@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "rtcl/error.hpp"
+#include "rtcl/shared/render_layouts.h"  // rtcl_hash
 
 namespace rtcl::bench {
 
@@ -16,17 +17,6 @@ constexpr float infinity = std::numeric_limits<float>::infinity();
 
 Ray make_ray(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) {
   return Ray{o.x, o.y, o.z, d.x, d.y, d.z, tmin, tmax};
-}
-
-// A 32-bit integer mixer (xor-shift / multiply rounds): decorrelates
-// consecutive pixel indices into independent-looking random bits.
-std::uint32_t mix(std::uint32_t x) {
-  x ^= x >> 16;
-  x *= 0x7feb352du;
-  x ^= x >> 15;
-  x *= 0x846ca68bu;
-  x ^= x >> 16;
-  return x;
 }
 
 float unit_float(std::uint32_t bits) { return static_cast<float>(bits >> 8) * 0x1p-24f; }  // [0, 1)
@@ -94,7 +84,7 @@ SecondaryRays secondary_rays(const Geometry& geometry, const RaySet& primary, co
     glm::vec3 origin = p + spawn_offset(p, scene_extent) * n;
     out.shadow.push_back(make_ray(origin, light - origin, 0.0f, 1.0f));
     auto pixel = static_cast<std::uint32_t>(i);
-    float u1 = unit_float(mix(2u * pixel + 0x9e3779b9u)), u2 = unit_float(mix(2u * pixel + 1u + 0x9e3779b9u));
+    float u1 = unit_float(rtcl_hash(2u * pixel + 0x9e3779b9u)), u2 = unit_float(rtcl_hash(2u * pixel + 1u + 0x9e3779b9u));
     out.diffuse.push_back(make_ray(origin, cosine_direction(n, u1, u2), 0.0f, infinity));
   }
   return out;
