@@ -4,12 +4,12 @@
 
 inline void brute_traverse(const TraceRay* s, HitState* h, global const TriangleBlock* triangles,
                            uint triangle_block_count, global const SphereBlock* spheres,
-                           uint sphere_block_count, const int any_hit) {
+                           uint sphere_block_count) {
   for (uint b = 0; b < triangle_block_count; ++b)
-    if (intersect_triangles8(triangles + b, s, h) && any_hit) return;
+    if (intersect_triangles8(triangles + b, s, h) && RTCL_ANY_HIT) return;
 #ifdef RTCL_HAS_SPHERES
   for (uint b = 0; b < sphere_block_count; ++b)
-    if (intersect_spheres8(spheres + b, s, h) && any_hit) return;
+    if (intersect_spheres8(spheres + b, s, h) && RTCL_ANY_HIT) return;
 #endif
 }
 

@@ -29,7 +29,7 @@
 
 __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
                                             global const TriangleBlock* triangles,
-                                            global const SphereBlock* spheres, const int any_hit) {
+                                            global const SphereBlock* spheres) {
   int stack_ref[RTCL_STACK_SIZE];
   float stack_t[RTCL_STACK_SIZE]; /* entry distance of stack_ref's box */
   int sp = 0;
@@ -46,7 +46,7 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
   if (hit.s##k) {                                            \
     float t = t_entry.s##k;                                  \
     int j = sp++;                                            \
-    while (!any_hit && j > base && stack_t[j - 1] < t) {     \
+    while (!RTCL_ANY_HIT && j > base && stack_t[j - 1] < t) {     \
       stack_t[j] = stack_t[j - 1];                           \
       stack_ref[j] = stack_ref[j - 1];                       \
       --j;                                                   \
@@ -62,10 +62,10 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
       int leaf = ~ref;
 #ifdef RTCL_HAS_SPHERES
       if (leaf & 1) {
-        if (intersect_spheres8(spheres + (leaf >> 1), s, h) && any_hit) return;
+        if (intersect_spheres8(spheres + (leaf >> 1), s, h) && RTCL_ANY_HIT) return;
       } else
 #endif
-      if (intersect_triangles8(triangles + (leaf >> 1), s, h) && any_hit) return;
+      if (intersect_triangles8(triangles + (leaf >> 1), s, h) && RTCL_ANY_HIT) return;
     }
     do {
       if (sp == 0) return;

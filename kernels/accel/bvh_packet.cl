@@ -11,14 +11,16 @@
  *
  * Contract: rays 8p .. 8p+7 (those below ray_count) form packet p; any rays
  * work (coherent ones, e.g. screen tiles or Morton order, are faster). Every
- * ray gets exactly the arithmetic of accel/bvh.cl (intersect.h): the same
- * slab distances and the same watertight edge functions, lane by lane, so
- * closest-hit t is bit-identical to the single-ray kernel (the primitive may
- * differ between two at exactly the same t). Any hit reports some hit.
+ * ray gets exactly the arithmetic of accel/bvh.cl (shared/box.h,
+ * shared/triangle.h, shared/sphere.h) at every precision level: the same
+ * slab distances and the same triangle tests, lane by lane, so closest-hit
+ * t is bit-identical to the single-ray kernel (at the robust and fast levels
+ * the primitive may differ between two at exactly the same t; at the exact
+ * level the smaller id wins there too). Any hit reports some hit.
  *
  * Stack bound: as in accel/bvh.cl (a node pushes at most its children and
  * pops one), so the host's RTCL_STACK_SIZE is valid here too. */
-#include "shared/intersect.h"
+#include "shared/trace.h"
 
 #ifndef RTCL_STACK_SIZE
 #define RTCL_STACK_SIZE 64
@@ -33,7 +35,9 @@ typedef struct TracePacket {
   int8 kx1, kx2, ky1, ky2, kz1, kz2; /* kx == 1, kx == 2, ... (axis permutation) */
   float8 sx, sy, sz;
   float8 okx, oky, okz;
+  float8 dkx, dky, dkz; /* direction, permuted */
   float8 dx, dy, dz;
+  float8 tmax;
   int8 active;
 } TracePacket;
 
@@ -44,6 +48,7 @@ inline float8 rtcl_pick_axis(float8 x, float8 y, float8 z, int8 k1, int8 k2) {
 
 inline void packet_setup(global const Ray* rays, uint first, uint ray_count, TracePacket* p, float8* tmax) {
   float lanes[8][8];  /* [field][lane] */
+  int valid[8];
   for (int l = 0; l < 8; ++l) {
     uint i = first + (uint)l;
     Ray r;
@@ -57,6 +62,7 @@ inline void packet_setup(global const Ray* rays, uint first, uint ray_count, Tra
     lanes[0][l] = r.ox; lanes[1][l] = r.oy; lanes[2][l] = r.oz;
     lanes[3][l] = r.dx; lanes[4][l] = r.dy; lanes[5][l] = r.dz;
     lanes[6][l] = r.tmin; lanes[7][l] = r.tmax;
+    valid[l] = -rtcl_ray_valid(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, r.tmin, r.tmax);
   }
   float8 ox = vload8(0, lanes[0]), oy = vload8(0, lanes[1]), oz = vload8(0, lanes[2]);
   float8 dx = vload8(0, lanes[3]), dy = vload8(0, lanes[4]), dz = vload8(0, lanes[5]);
@@ -66,7 +72,8 @@ inline void packet_setup(global const Ray* rays, uint first, uint ray_count, Tra
   /* kz = dominant axis, ties as in trace_ray_setup */
   int8 kz = select(select((int8)(2), (int8)(1), ay > az), select((int8)(2), (int8)(0), ax > az), ax > ay);
   float8 adk = select(select(az, ay, kz == 1), ax, kz == 0);
-  p->active = (adk > 0.0f) & (tmin <= *tmax) & !isnan(ox + oy + oz + dx + dy + dz);
+  p->active = (adk > 0.0f) & vload8(0, valid);
+  p->tmax = *tmax;
   int8 kx = select(kz + 1, (int8)(0), kz == 2);
   int8 ky = select(kx + 1, (int8)(0), kx == 2);
   float8 dkz = rtcl_pick_axis(dx, dy, dz, kz == 1, kz == 2);
@@ -89,15 +96,41 @@ inline void packet_setup(global const Ray* rays, uint first, uint ray_count, Tra
   p->okx = rtcl_pick_axis(ox, oy, oz, p->kx1, p->kx2);
   p->oky = rtcl_pick_axis(ox, oy, oz, p->ky1, p->ky2);
   p->okz = rtcl_pick_axis(ox, oy, oz, p->kz1, p->kz2);
+  p->dkx = rtcl_pick_axis(dx, dy, dz, p->kx1, p->kx2);
+  p->dky = rtcl_pick_axis(dx, dy, dz, p->ky1, p->ky2);
+  p->dkz = dkz;
 }
 
-/* Closest-hit state of the packet, lane = ray: t_best as in HitState; the
- * winning edge functions are kept and turned into (u, v) at the end, as
- * intersect_triangles8 does for its winner. */
+/* Closest-hit state of the packet, lane = ray: t_best (and at the exact
+ * level t_exact) as in HitState; the winning edge functions are kept and
+ * turned into (u, v) at the end, as intersect_triangle_lanes does for its
+ * winner (fast and exact keep u, v themselves, with det = 1). */
 typedef struct PacketHits {
   float8 t_best, det, V, W;
   int8 prim;
+#ifdef RTCL_PRECISION_EXACT
+  double t_exact[8];
+#endif
 } PacketHits;
+
+/* Lane l as an int8 mask. */
+inline int8 rtcl_lane_mask(int l) { return (int8)(0, 1, 2, 3, 4, 5, 6, 7) == (int8)(l); }
+
+#ifdef RTCL_PRECISION_EXACT
+/* Records a double-precision hit of lane l when it beats the lane's best
+ * (exact_better). Returns 1 if it did. */
+inline int packet_exact_record(PacketHits* h, int l, double t, int prim, float tmin, float tmax, float u, float v) {
+  if (!exact_better(t, prim, h->t_exact[l], rtcl_lane_i(h->prim, l), tmin, tmax)) return 0;
+  int8 m = rtcl_lane_mask(l);
+  h->t_exact[l] = t;
+  h->t_best = select(h->t_best, (float8)(convert_float_rtp(t)), m);
+  h->det = select(h->det, (float8)(1.0f), m);
+  h->V = select(h->V, (float8)(u), m);
+  h->W = select(h->W, (float8)(v), m);
+  h->prim = select(h->prim, (int8)(prim), m);
+  return 1;
+}
+#endif
 
 /* Child c's box against the packet over [tmin, t_best]: intersect_boxes8's
  * arithmetic per lane (entry plane chosen by the lane's direction sign).
@@ -113,29 +146,61 @@ inline float8 packet_box(global const Bvh8Node* node, int c, const TracePacket* 
   float8 tfz = (select((float8)(lz), (float8)(uz), p->pos_z) - p->oz) * p->iz;
   float8 tn = rtcl_fmax8(tnx, rtcl_fmax8(tny, rtcl_fmax8(tnz, p->tmin)));
   float8 tf = rtcl_fmin8(tfx, rtcl_fmin8(tfy, rtcl_fmin8(tfz, t_best)));
-  tn = tn - fabs(tn) * RTCL_SLAB_WIDEN;
-  tf = tf + fabs(tf) * RTCL_SLAB_WIDEN;
+  rtcl_widen_slab(&tn, &tf);
   return select((float8)(NAN), tn, mask & (tn <= tf));
 }
 
 /* Triangle k of a block against the packet's rays in `mask`:
- * intersect_triangles8's arithmetic per lane. Returns the lanes it hits in
- * [tmin, t_best) and records those hits. */
+ * intersect_triangle_lanes's arithmetic per lane. Returns the lanes it hits
+ * in [tmin, t_best) (exact: by exact_better) and records those hits. */
 inline int8 packet_triangle(global const TriangleBlock* block, int k, const TracePacket* p, PacketHits* h,
                             int8 mask) {
-  /* v[vertex][axis][lane]: vertex j's coordinates, permuted per ray */
-  float8 az = rtcl_pick_axis((float8)(block->v[0][0][k]), (float8)(block->v[0][1][k]), (float8)(block->v[0][2][k]), p->kz1, p->kz2) - p->okz;
-  float8 bz = rtcl_pick_axis((float8)(block->v[1][0][k]), (float8)(block->v[1][1][k]), (float8)(block->v[1][2][k]), p->kz1, p->kz2) - p->okz;
-  float8 cz = rtcl_pick_axis((float8)(block->v[2][0][k]), (float8)(block->v[2][1][k]), (float8)(block->v[2][2][k]), p->kz1, p->kz2) - p->okz;
-  float8 ax = rtcl_pick_axis((float8)(block->v[0][0][k]), (float8)(block->v[0][1][k]), (float8)(block->v[0][2][k]), p->kx1, p->kx2) - p->okx - p->sx * az;
-  float8 ay = rtcl_pick_axis((float8)(block->v[0][0][k]), (float8)(block->v[0][1][k]), (float8)(block->v[0][2][k]), p->ky1, p->ky2) - p->oky - p->sy * az;
-  float8 bx = rtcl_pick_axis((float8)(block->v[1][0][k]), (float8)(block->v[1][1][k]), (float8)(block->v[1][2][k]), p->kx1, p->kx2) - p->okx - p->sx * bz;
-  float8 by = rtcl_pick_axis((float8)(block->v[1][0][k]), (float8)(block->v[1][1][k]), (float8)(block->v[1][2][k]), p->ky1, p->ky2) - p->oky - p->sy * bz;
-  float8 cx = rtcl_pick_axis((float8)(block->v[2][0][k]), (float8)(block->v[2][1][k]), (float8)(block->v[2][2][k]), p->kx1, p->kx2) - p->okx - p->sx * cz;
-  float8 cy = rtcl_pick_axis((float8)(block->v[2][0][k]), (float8)(block->v[2][1][k]), (float8)(block->v[2][2][k]), p->ky1, p->ky2) - p->oky - p->sy * cz;
+  /* vertex j's coordinates on each ray's permuted axes */
+  float8 v[3][3];
+  for (int j = 0; j < 3; ++j) {
+    float8 x = (float8)(block->v[j][0][k]), y = (float8)(block->v[j][1][k]), z = (float8)(block->v[j][2][k]);
+    v[j][0] = rtcl_pick_axis(x, y, z, p->kx1, p->kx2);
+    v[j][1] = rtcl_pick_axis(x, y, z, p->ky1, p->ky2);
+    v[j][2] = rtcl_pick_axis(x, y, z, p->kz1, p->kz2);
+  }
+#ifdef RTCL_PRECISION_FAST
+  float8 t, u, w;
+  int8 ok = mask & rtcl_moller_trumbore8(v[0][0], v[0][1], v[0][2], v[1][0], v[1][1], v[1][2], v[2][0], v[2][1],
+                                         v[2][2], p->okx, p->oky, p->okz, p->dkx, p->dky, p->dkz, p->tmin,
+                                         h->t_best, &t, &u, &w);
+  if (!rtcl_any8(ok)) return ok;
+  h->t_best = select(h->t_best, t, ok);
+  h->det = select(h->det, (float8)(1.0f), ok);
+  h->V = select(h->V, u, ok);
+  h->W = select(h->W, w, ok);
+  h->prim = select(h->prim, (int8)(block->prim[k]), ok);
+  return ok;
+#else
+  float8 az = v[0][2] - p->okz, bz = v[1][2] - p->okz, cz = v[2][2] - p->okz;
+  float8 ax = v[0][0] - p->okx - p->sx * az, ay = v[0][1] - p->oky - p->sy * az;
+  float8 bx = v[1][0] - p->okx - p->sx * bz, by = v[1][1] - p->oky - p->sy * bz;
+  float8 cx = v[2][0] - p->okx - p->sx * cz, cy = v[2][1] - p->oky - p->sy * cz;
   float8 U = rtcl_edge8(cx, cy, bx, by);
   float8 V = rtcl_edge8(ax, ay, cx, cy);
   float8 W = rtcl_edge8(bx, by, ax, ay);
+#ifdef RTCL_PRECISION_EXACT
+  int8 cand = mask & rtcl_exact_triangle_candidates(ax, ay, az, bx, by, bz, cx, cy, cz, U, V, W, p->sz, p->tmin,
+                                                    h->t_best);
+  if (!rtcl_any8(cand)) return cand;
+  int prim = block->prim[k];
+  int hit[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (int l = 0; l < 8; ++l) {
+    if (!rtcl_lane_i(cand, l)) continue;
+    double u = 0.0, w = 0.0;
+    double t = exact_triangle(rtcl_lane(v[0][0], l), rtcl_lane(v[0][1], l), rtcl_lane(v[0][2], l),
+                              rtcl_lane(v[1][0], l), rtcl_lane(v[1][1], l), rtcl_lane(v[1][2], l),
+                              rtcl_lane(v[2][0], l), rtcl_lane(v[2][1], l), rtcl_lane(v[2][2], l),
+                              rtcl_lane(p->okx, l), rtcl_lane(p->oky, l), rtcl_lane(p->okz, l),
+                              rtcl_lane(p->dkx, l), rtcl_lane(p->dky, l), rtcl_lane(p->dkz, l), &u, &w);
+    hit[l] = -packet_exact_record(h, l, t, prim, rtcl_lane(p->tmin, l), rtcl_lane(p->tmax, l), (float)u, (float)w);
+  }
+  return vload8(0, hit);
+#else
   int8 inside = ((U >= 0.0f) & (V >= 0.0f) & (W >= 0.0f)) | ((U <= 0.0f) & (V <= 0.0f) & (W <= 0.0f));
   float8 det = U + V + W;
   float8 T = p->sz * (U * az + V * bz + W * cz);
@@ -148,11 +213,13 @@ inline int8 packet_triangle(global const TriangleBlock* block, int k, const Trac
   h->W = select(h->W, W, ok);
   h->prim = select(h->prim, (int8)(block->prim[k]), ok);
   return ok;
+#endif
+#endif
 }
 
 #ifdef RTCL_HAS_SPHERES
-/* Sphere k of a block against the packet: intersect_spheres8's arithmetic
- * per lane (Haines et al., Ray Tracing Gems ch. 7). */
+/* Sphere k of a block against the packet: intersect_sphere_lanes's
+ * arithmetic per lane (Haines et al., Ray Tracing Gems ch. 7). */
 inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePacket* p, PacketHits* h, int8 mask) {
   float r = block->r[k];
   float8 fx = p->ox - block->cx[k];
@@ -162,7 +229,23 @@ inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePac
   float8 b = -(fx * p->dx + fy * p->dy + fz * p->dz);
   float8 kk = b / a;
   float8 lx = fx + kk * p->dx, ly = fy + kk * p->dy, lz = fz + kk * p->dz;
-  float8 disc = a * (r * r - (lx * lx + ly * ly + lz * lz));
+  float8 l2 = lx * lx + ly * ly + lz * lz;
+  float8 disc = a * (r * r - l2);
+#ifdef RTCL_PRECISION_EXACT
+  int8 cand = mask & (disc >= -(RTCL_EXACT_EDGE_ULPS * FLT_EPSILON) * a * (r * r + l2 + fx * fx + fy * fy + fz * fz));
+  if (!rtcl_any8(cand)) return cand;
+  int prim = block->prim[k];
+  int hit[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (int l = 0; l < 8; ++l) {
+    if (!rtcl_lane_i(cand, l)) continue;
+    float tmin = rtcl_lane(p->tmin, l), tmax = rtcl_lane(p->tmax, l);
+    double t = exact_sphere(block->cx[k], block->cy[k], block->cz[k], r, rtcl_lane(p->ox, l), rtcl_lane(p->oy, l),
+                            rtcl_lane(p->oz, l), rtcl_lane(p->dx, l), rtcl_lane(p->dy, l), rtcl_lane(p->dz, l), tmin,
+                            tmax);
+    hit[l] = -packet_exact_record(h, l, t, prim, tmin, tmax, 0.0f, 0.0f);
+  }
+  return vload8(0, hit);
+#endif
   int8 real = disc >= 0.0f;
   float8 c = fx * fx + fy * fy + fz * fz - r * r;
   float8 q = b + copysign(sqrt(fmax(disc, 0.0f)), b);
@@ -182,11 +265,11 @@ inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePac
 }
 #endif
 
-/* Traverses the packet. any_hit: a ray leaves the packet at its first hit;
+/* Traverses the packet. Any hit: a ray leaves the packet at its first hit;
  * the traversal ends when every ray has. */
 __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketHits* h, global const Bvh8Node* nodes,
                                                    global const TriangleBlock* triangles,
-                                                   global const SphereBlock* spheres, const int any_hit) {
+                                                   global const SphereBlock* spheres) {
   float8 stack_t[RTCL_STACK_SIZE]; /* entry distances of stack_ref's box, NaN: ray not in it */
   int stack_ref[RTCL_STACK_SIZE];
   float stack_key[RTCL_STACK_SIZE]; /* nearest entry distance over the packet: visiting order */
@@ -207,7 +290,7 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
         float key = rtcl_min8(select((float8)(INFINITY), tn, in));
         /* insertion into [base, sp) kept sorted by decreasing key */
         int j = sp++;
-        while (!any_hit && j > base && stack_key[j - 1] < key) {
+        while (!RTCL_ANY_HIT && j > base && stack_key[j - 1] < key) {
           stack_key[j] = stack_key[j - 1];
           stack_t[j] = stack_t[j - 1];
           stack_ref[j] = stack_ref[j - 1];
@@ -225,7 +308,7 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
         for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
           if (block->prim[k] < 0) continue;
           int8 hit = packet_sphere(block, k, p, h, mask);
-          if (any_hit) {
+          if (RTCL_ANY_HIT) {
             alive &= ~hit;
             mask &= ~hit;
           }
@@ -237,13 +320,13 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
         for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
           if (block->prim[k] < 0) continue;
           int8 hit = packet_triangle(block, k, p, h, mask);
-          if (any_hit) {
+          if (RTCL_ANY_HIT) {
             alive &= ~hit;
             mask &= ~hit;
           }
         }
       }
-      if (any_hit && !rtcl_any8(alive)) return;
+      if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
     }
     /* pop the next entry some ray still needs: entered before its best hit */
     for (;;) {
@@ -257,7 +340,7 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
 }
 
 inline void packet_trace(global const Ray* rays, global Hit* hits, uint ray_count, global const Bvh8Node* nodes,
-                         global const TriangleBlock* triangles, global const SphereBlock* spheres, int any_hit) {
+                         global const TriangleBlock* triangles, global const SphereBlock* spheres) {
   uint first = get_global_id(0) * 8u;
   if (first >= ray_count) return;
   TracePacket p;
@@ -268,7 +351,10 @@ inline void packet_trace(global const Ray* rays, global Hit* hits, uint ray_coun
   h.det = (float8)(1.0f);
   h.V = h.W = (float8)(0.0f);
   h.prim = (int8)(-1);
-  if (rtcl_any8(p.active)) bvh_packet_traverse(&p, &h, nodes, triangles, spheres, any_hit);
+#ifdef RTCL_PRECISION_EXACT
+  for (int l = 0; l < 8; ++l) h.t_exact[l] = INFINITY;
+#endif
+  if (rtcl_any8(p.active)) bvh_packet_traverse(&p, &h, nodes, triangles, spheres);
   float inv_det[8], V[8], W[8], t[8];
   int prim[8];
   vstore8(h.t_best, 0, t);
@@ -279,7 +365,11 @@ inline void packet_trace(global const Ray* rays, global Hit* hits, uint ray_coun
   for (uint l = 0; l < 8u && first + l < ray_count; ++l) {
     Hit out;
     float id = 1.0f / inv_det[l];
+#ifdef RTCL_PRECISION_EXACT
+    out.t = prim[l] < 0 ? INFINITY : convert_float_rte(h.t_exact[l]);
+#else
     out.t = prim[l] < 0 ? INFINITY : t[l];
+#endif
     out.u = V[l] * id;
     out.v = W[l] * id;
     out.prim = prim[l];
@@ -287,14 +377,8 @@ inline void packet_trace(global const Ray* rays, global Hit* hits, uint ray_coun
   }
 }
 
-kernel void trace_closest_bvh_packet(global const Ray* rays, global Hit* hits, uint ray_count,
-                                     global const Bvh8Node* nodes, global const TriangleBlock* triangles,
-                                     global const SphereBlock* spheres) {
-  packet_trace(rays, hits, ray_count, nodes, triangles, spheres, 0);
-}
-
-kernel void trace_any_bvh_packet(global const Ray* rays, global Hit* hits, uint ray_count,
-                                 global const Bvh8Node* nodes, global const TriangleBlock* triangles,
-                                 global const SphereBlock* spheres) {
-  packet_trace(rays, hits, ray_count, nodes, triangles, spheres, 1);
+kernel void RTCL_TRACE_KERNEL_NAME(bvh_packet)(global const Ray* rays, global Hit* hits, uint ray_count,
+                                               global const Bvh8Node* nodes, global const TriangleBlock* triangles,
+                                               global const SphereBlock* spheres) {
+  packet_trace(rays, hits, ray_count, nodes, triangles, spheres);
 }

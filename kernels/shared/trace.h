@@ -1,50 +1,49 @@
-/* What every trace kernel does around its traversal: read the ray, set it up,
- * write the hit. OpenCL C only. */
+/* What every single-ray trace kernel does around its traversal: read the
+ * ray, set it up, write the hit; and the primitive and box tests it uses.
+ * OpenCL C only. */
 #ifndef RTCL_SHARED_TRACE_H
 #define RTCL_SHARED_TRACE_H
 
-#include "shared/intersect.h"
+#include "shared/box.h"
+#include "shared/sphere.h"
+#include "shared/triangle.h"
 
 /* Returns 0 (and leaves a miss in h) for a ray that cannot be traced. */
 inline int begin_trace(global const Ray* rays, uint i, TraceRay* s, HitState* h) {
   Ray r = rays[i];
-  h->t_best = nextafter(r.tmax, INFINITY);
-  h->u = 0.0f;
-  h->v = 0.0f;
-  h->prim = -1;
+  hit_state_init(h, r.tmax);
   return trace_ray_setup(r, s);
 }
 
 inline void end_trace(global Hit* hits, uint i, const HitState* h) {
   Hit out;
-  out.t = h->prim < 0 ? INFINITY : h->t_best;
+  out.t = hit_state_t(h);
   out.u = h->u;
   out.v = h->v;
   out.prim = h->prim;
   hits[i] = out;
 }
 
-/* Defines trace_closest_NAME and trace_any_NAME from an inline function
- * NAME_traverse(const TraceRay*, HitState*, STRUCTURE_PARAMS..., int any_hit)
- * which this macro calls with the kernels' structure arguments. */
-#define RTCL_TRACE_KERNELS(NAME, PARAMS, ARGS)                                                \
-  kernel void trace_closest_##NAME(global const Ray* rays, global Hit* hits, uint ray_count,  \
-                                   PARAMS) {                                                  \
-    uint i = get_global_id(0);                                                                \
-    if (i >= ray_count) return;                                                               \
-    TraceRay s;                                                                               \
-    HitState h;                                                                               \
-    if (begin_trace(rays, i, &s, &h)) NAME##_traverse(&s, &h, ARGS, 0);                       \
-    end_trace(hits, i, &h);                                                                   \
-  }                                                                                           \
-  kernel void trace_any_##NAME(global const Ray* rays, global Hit* hits, uint ray_count,      \
-                               PARAMS) {                                                      \
-    uint i = get_global_id(0);                                                                \
-    if (i >= ray_count) return;                                                               \
-    TraceRay s;                                                                               \
-    HitState h;                                                                               \
-    if (begin_trace(rays, i, &s, &h)) NAME##_traverse(&s, &h, ARGS, 1);                       \
-    end_trace(hits, i, &h);                                                                   \
+/* The kernel of this program's query: trace_closest_NAME when built with
+ * RTCL_QUERY_CLOSEST, trace_any_NAME with RTCL_QUERY_ANY. */
+#ifdef RTCL_QUERY_ANY
+#define RTCL_TRACE_KERNEL_NAME(NAME) trace_any_##NAME
+#else
+#define RTCL_TRACE_KERNEL_NAME(NAME) trace_closest_##NAME
+#endif
+
+/* Defines the kernel from an inline function
+ * NAME_traverse(const TraceRay*, HitState*, STRUCTURE_PARAMS...), which
+ * ends at its first hit when RTCL_ANY_HIT is 1. */
+#define RTCL_TRACE_KERNELS(NAME, PARAMS, ARGS)                                                      \
+  kernel void RTCL_TRACE_KERNEL_NAME(NAME)(global const Ray* rays, global Hit* hits, uint ray_count, \
+                                           PARAMS) {                                                 \
+    uint i = get_global_id(0);                                                                      \
+    if (i >= ray_count) return;                                                                     \
+    TraceRay s;                                                                                     \
+    HitState h;                                                                                     \
+    if (begin_trace(rays, i, &s, &h)) NAME##_traverse(&s, &h, ARGS);                                \
+    end_trace(hits, i, &h);                                                                         \
   }
 
 #endif

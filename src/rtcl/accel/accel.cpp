@@ -4,38 +4,48 @@
 
 namespace rtcl {
 
+namespace {
+
+std::vector<std::string> with_precision(const DeviceInfo& device, std::vector<std::string> defines,
+                                        Precision precision) {
+  require_precision(device, precision);
+  for (std::string& option : precision_build_options(precision)) defines.push_back(std::move(option));
+  return defines;
+}
+
+}  // namespace
+
 Accel::Accel(const Device& device, std::string name, TraceKernels incoherent, std::optional<TraceKernels> coherent,
-             std::vector<std::string> defines, AccelStats stats)
+             std::vector<std::string> defines, AccelStats stats, const AccelConfig& config)
     : device_(device),
       name_(std::move(name)),
       stats_(stats),
-      defines_(std::move(defines)),
-      coherent_spec_(std::move(coherent)),
-      incoherent_(make_kernels(incoherent)) {}
+      precision_(config.precision),
+      defines_(with_precision(device.info(), std::move(defines), config.precision)),
+      incoherent_{std::move(incoherent), {}, {}} {
+  if (coherent) coherent_ = KernelSet{std::move(*coherent), {}, {}};
+  kernel_for(Coherence::incoherent, Query::closest);
+}
 
-Accel::KernelSet Accel::make_kernels(const TraceKernels& kernels) const {
-  cl::Program program = device_.program(kernels.file, defines_);
-  std::string stem = kernels.file.substr(kernels.file.rfind('/') + 1);
+Accel::KernelSet& Accel::set_for(Coherence coherence) const {
+  return coherence == Coherence::coherent && coherent_ ? *coherent_ : incoherent_;
+}
+
+Accel::QueryKernel& Accel::kernel_for(Coherence coherence, Query query) const {
+  KernelSet& set = set_for(coherence);
+  std::optional<QueryKernel>& slot = query == Query::closest ? set.closest : set.any;
+  if (slot) return *slot;
+  std::vector<std::string> defines = defines_;
+  defines.push_back(query == Query::closest ? "RTCL_QUERY_CLOSEST" : "RTCL_QUERY_ANY");
+  cl::Program program = device_.program(set.spec.file, defines);
+  std::string stem = set.spec.file.substr(set.spec.file.rfind('/') + 1);
   stem = stem.substr(0, stem.rfind('.'));
-  KernelSet set;
-  set.rays_per_work_item = kernels.rays_per_work_item;
-  with_cl_errors([&] {
-    set.closest = cl::Kernel(program, ("trace_closest_" + stem).c_str());
-    set.any = cl::Kernel(program, ("trace_any_" + stem).c_str());
-  });
-  return set;
+  std::string kernel_name = (query == Query::closest ? "trace_closest_" : "trace_any_") + stem;
+  with_cl_errors([&] { slot = QueryKernel{cl::Kernel(program, kernel_name.c_str()), false}; });
+  return *slot;
 }
 
-Accel::KernelSet& Accel::kernels_for(Coherence coherence) const {
-  if (coherence == Coherence::incoherent || !coherent_spec_) return incoherent_;
-  if (!coherent_) coherent_ = make_kernels(*coherent_spec_);
-  return *coherent_;
-}
-
-std::size_t Accel::rays_per_work_item(Coherence coherence) const {
-  if (coherence == Coherence::coherent && coherent_spec_) return coherent_spec_->rays_per_work_item;
-  return incoherent_.rays_per_work_item;
-}
+std::size_t Accel::rays_per_work_item(Coherence coherence) const { return set_for(coherence).spec.rays_per_work_item; }
 
 cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hits, std::size_t ray_count,
                        const std::vector<cl::Event>& wait, Coherence coherence) const {
@@ -48,13 +58,12 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     if (hit_bytes < ray_count * sizeof(Hit))
       throw Error(name_ + " trace: hit buffer holds " + std::to_string(hit_bytes / sizeof(Hit)) + " hits, " +
                   std::to_string(ray_count) + " requested");
-    KernelSet& set = kernels_for(coherence);
-    if (!set.args_set) {  // not in make_kernels: the constructor runs before the structure exists
-      set_structure_args(set.closest, 3);
-      set_structure_args(set.any, 3);
-      set.args_set = true;
+    QueryKernel& slot = kernel_for(coherence, query);
+    if (!slot.args_set) {
+      set_structure_args(slot.kernel, 3);
+      slot.args_set = true;
     }
-    cl::Kernel& kernel = query == Query::closest ? set.closest : set.any;
+    cl::Kernel& kernel = slot.kernel;
     kernel.setArg(0, rays);
     kernel.setArg(1, hits);
     kernel.setArg(2, static_cast<cl_uint>(ray_count));
@@ -68,7 +77,8 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     // one per global size, so each new ray count would cost a code generation.
     const std::size_t group = 64;
     bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device()) >= group;
-    std::size_t items = (ray_count + set.rays_per_work_item - 1) / set.rays_per_work_item;
+    std::size_t per_item = rays_per_work_item(coherence);
+    std::size_t items = (ray_count + per_item - 1) / per_item;
     std::size_t global = fixed ? (items + group - 1) / group * group : items;
     device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
                                          fixed ? cl::NDRange(group) : cl::NullRange,

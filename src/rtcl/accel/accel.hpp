@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rtcl/accel/precision.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/scene/geometry.hpp"
 
@@ -36,6 +37,11 @@ enum class Coherence {
   coherent,
 };
 
+// How a structure is built and which kernels it compiles.
+struct AccelConfig {
+  Precision precision = Precision::robust;
+};
+
 struct AccelStats {
   double build_ms = 0.0;             // host build + flatten, without upload
   std::size_t device_bytes = 0;      // structure + primitive data on the device
@@ -54,10 +60,15 @@ class Accel {
   const std::string& name() const { return name_; }
   const AccelStats& stats() const { return stats_; }
   const Device& device() const { return device_; }
+  Precision precision() const { return precision_; }
 
   // Consecutive rays one work-item traces in calls of this coherence: 1
   // (single-ray kernel) or 8 (packet kernel).
   std::size_t rays_per_work_item(Coherence coherence) const;
+
+  // The -D options (and -cl-... flags) its trace programs are built with,
+  // before the query's RTCL_QUERY_CLOSEST / RTCL_QUERY_ANY.
+  const std::vector<std::string>& build_options() const { return defines_; }
 
   // Enqueues the query for rays[0 .. ray_count) into hits[0 .. ray_count) on
   // the device's queue after `wait`; returns the kernel's event. `coherence`
@@ -73,7 +84,9 @@ class Accel {
 
  protected:
   // The trace kernels of one kernel file: "accel/bvh.cl" defines
-  // trace_closest_bvh and trace_any_bvh. Each work-item traces
+  // trace_closest_bvh when built with -DRTCL_QUERY_CLOSEST and
+  // trace_any_bvh with -DRTCL_QUERY_ANY (two specialised programs, each
+  // built at the first query of its kind). Each work-item traces
   // rays_per_work_item consecutive rays (1, or 8 for a packet kernel); a
   // launch covers ceil(ray_count / rays_per_work_item) work-items.
   struct TraceKernels {
@@ -81,38 +94,47 @@ class Accel {
     std::size_t rays_per_work_item = 1;
   };
   // `incoherent` serves Coherence::incoherent calls, and coherent ones too
-  // when `coherent` is absent. Both are built with `defines`; `incoherent`
-  // here, `coherent` at the first coherent call (a caller that never makes
-  // one never pays its build).
+  // when `coherent` is absent. Both are built with `defines` plus the
+  // precision level's options, each (coherence, query) program at its first
+  // call: a caller that never makes one never pays its build. The
+  // constructor builds the incoherent closest-hit program, so that a bad
+  // kernel fails at construction. Throws Error when the device cannot run
+  // config.precision.
   Accel(const Device& device, std::string name, TraceKernels incoherent, std::optional<TraceKernels> coherent,
-        std::vector<std::string> defines, AccelStats stats);
+        std::vector<std::string> defines, AccelStats stats, const AccelConfig& config);
   // Sets the structure's kernel arguments, starting at argument `first`.
   virtual void set_structure_args(cl::Kernel& kernel, cl_uint first) const = 0;
 
  private:
-  struct KernelSet {
-    cl::Kernel closest, any;
-    std::size_t rays_per_work_item = 1;
-    bool args_set = false;  // set_structure_args done (at the set's first trace)
+  struct QueryKernel {
+    cl::Kernel kernel;
+    bool args_set = false;  // set_structure_args done (at its first trace: the constructor runs before the structure exists)
   };
-  KernelSet make_kernels(const TraceKernels& kernels) const;
-  KernelSet& kernels_for(Coherence coherence) const;
+  // One kernel per query of one TraceKernels, each built at its first use.
+  struct KernelSet {
+    TraceKernels spec;
+    std::optional<QueryKernel> closest, any;
+  };
+  KernelSet& set_for(Coherence coherence) const;
+  QueryKernel& kernel_for(Coherence coherence, Query query) const;
 
   Device device_;
   std::string name_;
   AccelStats stats_;
-  std::vector<std::string> defines_;
-  std::optional<TraceKernels> coherent_spec_;
+  Precision precision_;
+  std::vector<std::string> defines_;  // structure's, then the precision level's
   mutable KernelSet incoherent_;
-  mutable std::optional<KernelSet> coherent_;  // built from coherent_spec_ at the first coherent call
+  mutable std::optional<KernelSet> coherent_;
 };
 
 // Names make_accel accepts, in the order benchmarks list them.
 std::vector<std::string> accel_names();
 
 // Builds the named structure over validated geometry and uploads it.
-// Throws Error naming the accel when the name is unknown.
-std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry);
+// Throws Error naming the accel when the name is unknown, and naming
+// --precision when the device cannot run config.precision.
+std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry,
+                                  const AccelConfig& config = {});
 
 // The -D options every trace program needs for this geometry.
 std::vector<std::string> primitive_defines(const Geometry& geometry);

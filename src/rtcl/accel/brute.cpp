@@ -12,8 +12,9 @@ namespace {
 
 class BruteAccel final : public Accel {
  public:
-  BruteAccel(const Device& device, const Geometry& geometry, PrimitiveBlocks blocks, AccelStats stats)
-      : Accel(device, "brute", {"accel/brute.cl"}, std::nullopt, primitive_defines(geometry), stats),
+  BruteAccel(const Device& device, const Geometry& geometry, PrimitiveBlocks blocks, AccelStats stats,
+             const AccelConfig& config)
+      : Accel(device, "brute", {"accel/brute.cl"}, std::nullopt, primitive_defines(geometry), stats, config),
         primitives_(upload(device, blocks)),
         triangle_blocks_(static_cast<cl_uint>(blocks.triangles.size())),
         sphere_blocks_(static_cast<cl_uint>(blocks.spheres.size())) {}
@@ -32,25 +33,18 @@ class BruteAccel final : public Accel {
 
 }  // namespace
 
-std::unique_ptr<Accel> make_brute(const Device& device, const Geometry& geometry) {
+std::unique_ptr<Accel> make_brute(const Device& device, const Geometry& geometry, const AccelConfig& config) {
   auto start = std::chrono::steady_clock::now();
   GeometryReport report = validate(geometry);
   std::vector<std::uint32_t> ids = stored_primitives(geometry);
-  PrimitiveBlocks blocks;
-  std::size_t first_sphere = ids.size() - geometry.spheres.size();
-  for (std::size_t begin = 0; begin < ids.size();) {
-    std::size_t kind_end = begin < first_sphere ? first_sphere : ids.size();
-    std::size_t end = std::min(begin + RTCL_BLOCK_WIDTH, kind_end);
-    blocks.append(geometry, std::span(ids).subspan(begin, end - begin));
-    begin = end;
-  }
+  PrimitiveBlocks blocks = in_order_blocks(geometry, ids);
   AccelStats stats;
   stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   stats.device_bytes = blocks.bytes();
   stats.primitive_count = ids.size();
   stats.zero_area_skipped = report.zero_area_triangles;
   stats.leaf_count = blocks.triangles.size() + blocks.spheres.size();
-  return std::make_unique<BruteAccel>(device, geometry, std::move(blocks), stats);
+  return std::make_unique<BruteAccel>(device, geometry, std::move(blocks), stats, config);
 }
 
 }  // namespace rtcl

@@ -7,6 +7,6 @@
 namespace rtcl {
 
 // Every ray against every primitive: O(rays x primitives), the reference.
-std::unique_ptr<Accel> make_brute(const Device& device, const Geometry& geometry);
+std::unique_ptr<Accel> make_brute(const Device& device, const Geometry& geometry, const AccelConfig& config = {});
 
 }  // namespace rtcl

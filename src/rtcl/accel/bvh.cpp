@@ -235,10 +235,11 @@ class BvhAccel final : public Accel {
 
  public:
   BvhAccel(const Device& device, std::string name, BvhTraversal traversal, std::vector<std::string> defines,
-           const Bvh8& bvh, AccelStats stats)
+           const Bvh8& bvh, AccelStats stats, const AccelConfig& config)
       : Accel(device, std::move(name),
               traversal == BvhTraversal::packet ? kPacket : TraceKernels{"accel/bvh.cl"},
-              traversal == BvhTraversal::packet ? std::nullopt : std::optional(kPacket), std::move(defines), stats),
+              traversal == BvhTraversal::packet ? std::nullopt : std::optional(kPacket), std::move(defines), stats,
+              config),
         nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
         primitives_(upload(device, bvh.blocks)) {}
 
@@ -277,7 +278,7 @@ Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_le
 std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size) { return std::max(8u, (stack_size + 7u) / 8u * 8u); }
 
 std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config,
-                                std::string name) {
+                                std::string name, const AccelConfig& accel_config) {
   auto start = std::chrono::steady_clock::now();
   GeometryReport report = validate(geometry);
   Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, config), geometry, config.merge_leaves);
@@ -290,23 +291,24 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
   stats.leaf_count = bvh.blocks.triangles.size() + bvh.blocks.spheres.size();
   std::vector<std::string> defines = primitive_defines(geometry);
   defines.push_back("RTCL_STACK_SIZE=" + std::to_string(bvh_kernel_stack_size(bvh.stack_size)));
-  return std::make_unique<BvhAccel>(device, std::move(name), config.traversal, std::move(defines), bvh, stats);
+  return std::make_unique<BvhAccel>(device, std::move(name), config.traversal, std::move(defines), bvh, stats,
+                                    accel_config);
 }
 
-std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry) {
-  return make_bvh(device, geometry, {}, "bvh");
+std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry, const AccelConfig& config) {
+  return make_bvh(device, geometry, {}, "bvh", config);
 }
 
-std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry) {
-  BvhConfig config;
-  config.builder = BvhBuilder::ploc;
-  return make_bvh(device, geometry, config, "bvh-ploc");
+std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry, const AccelConfig& config) {
+  BvhConfig bvh;
+  bvh.builder = BvhBuilder::ploc;
+  return make_bvh(device, geometry, bvh, "bvh-ploc", config);
 }
 
-std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry) {
-  BvhConfig config;
-  config.traversal = BvhTraversal::packet;
-  return make_bvh(device, geometry, config, "bvh-packet");
+std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry, const AccelConfig& config) {
+  BvhConfig bvh;
+  bvh.traversal = BvhTraversal::packet;
+  return make_bvh(device, geometry, bvh, "bvh-packet", config);
 }
 
 }  // namespace rtcl

@@ -85,13 +85,13 @@ std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size);
 // Builds, flattens and uploads; stats().build_ms covers build + flatten.
 // `name` is what Accel::name() reports ("bvh", "bvh-ploc").
 std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config = {},
-                                std::string name = "bvh");
+                                std::string name = "bvh", const AccelConfig& accel_config = {});
 
 // The registered structures: "bvh" (binned SAH, default config),
 // "bvh-ploc" (PLOC, default config) and "bvh-packet" (binned SAH,
 // BvhTraversal::packet).
-std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry);
-std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry);
-std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry);
+std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry, const AccelConfig& config);
+std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry, const AccelConfig& config);
+std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry, const AccelConfig& config);
 
 }  // namespace rtcl

@@ -1,5 +1,6 @@
 #include "rtcl/accel/primitive_blocks.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -64,6 +65,18 @@ DevicePrimitives upload(const Device& device, const PrimitiveBlocks& blocks) {
                                     "sphere blocks");
   out.bytes = blocks.bytes();
   return out;
+}
+
+PrimitiveBlocks in_order_blocks(const Geometry& geometry, const std::vector<std::uint32_t>& ids) {
+  PrimitiveBlocks blocks;
+  std::size_t first_sphere = ids.size() - geometry.spheres.size();
+  for (std::size_t begin = 0; begin < ids.size();) {
+    std::size_t kind_end = begin < first_sphere ? first_sphere : ids.size();
+    std::size_t end = std::min(begin + RTCL_BLOCK_WIDTH, kind_end);
+    blocks.append(geometry, std::span(ids).subspan(begin, end - begin));
+    begin = end;
+  }
+  return blocks;
 }
 
 std::vector<std::uint32_t> stored_primitives(const Geometry& g) {

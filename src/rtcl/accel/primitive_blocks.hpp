@@ -34,4 +34,12 @@ DevicePrimitives upload(const Device& device, const PrimitiveBlocks& blocks);
 // whose area is not zero.
 std::vector<std::uint32_t> stored_primitives(const Geometry& geometry);
 
+// The stored primitives (`ids` = stored_primitives(geometry)) in id order,
+// eight to a block: triangle k of `ids` is lane k & 7 of triangle block
+// k >> 3, sphere j is lane j & 7 of sphere block j >> 3. What brute force
+// walks, and what indexed structures (cells, leaves sharing primitives)
+// reference: a reference is that k or j (kernels/shared/triangle.h,
+// intersect_triangle_refs).
+PrimitiveBlocks in_order_blocks(const Geometry& geometry, const std::vector<std::uint32_t>& ids);
+
 }  // namespace rtcl

@@ -11,11 +11,11 @@ namespace rtcl {
 
 namespace {
 
-using Factory = std::function<std::unique_ptr<Accel>(const Device&, const Geometry&)>;
+using Factory = std::function<std::unique_ptr<Accel>(const Device&, const Geometry&, const AccelConfig&)>;
 
 const std::vector<std::pair<std::string, Factory>>& registry() {
   static const std::vector<std::pair<std::string, Factory>> entries = {
-      {"brute", make_brute},
+      {"brute", [](const Device& d, const Geometry& g, const AccelConfig& c) { return make_brute(d, g, c); }},
       {"bvh", make_bvh_sah},
       {"bvh-ploc", make_bvh_ploc},
       {"bvh-packet", make_bvh_packet},
@@ -31,9 +31,13 @@ std::vector<std::string> accel_names() {
   return names;
 }
 
-std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry) {
+std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry,
+                                  const AccelConfig& config) {
   for (const auto& entry : registry())
-    if (entry.first == name) return entry.second(device, geometry);
+    if (entry.first == name) {
+      require_precision(device.info(), config.precision);
+      return entry.second(device, geometry, config);
+    }
   std::string known;
   for (const auto& entry : registry()) known += (known.empty() ? "" : ", ") + entry.first;
   throw Error("--accel " + std::string(name) + ": unknown acceleration structure (known: " + known + ")");

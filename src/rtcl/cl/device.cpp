@@ -155,7 +155,7 @@ cl::Program Device::program(const std::string& kernel_file, const std::vector<st
   std::string source = kernel_source(kernel_file);
   std::string options = "-cl-std=CL1.2";
   if (state_->info.fp64) options += " -DRTCL_HAS_FP64";
-  for (const auto& d : defines) options += " -D" + d;
+  for (const auto& d : defines) options += (d.rfind("-cl-", 0) == 0 ? " " : " -D") + d;
   auto key = std::make_tuple(std::hash<std::string>{}(source), options);
   std::lock_guard lock(state_->cache_mutex);
   if (auto it = state_->programs.find(key); it != state_->programs.end()) return it->second;

@@ -48,7 +48,8 @@ class Device {
   bool profiling() const;  // the queue records event times
 
   // The program built from an embedded kernel file (path under kernels/,
-  // e.g. "accel/bvh.cl") with -D defines ("NAME" or "NAME=VALUE"). Cached per
+  // e.g. "accel/bvh.cl") with -D defines ("NAME" or "NAME=VALUE"; an entry
+  // starting with "-cl-", e.g. "-cl-fast-relaxed-math", is passed as it is). Cached per
   // device + source hash + options; a build failure throws Error with the log.
   cl::Program program(const std::string& kernel_file, const std::vector<std::string>& defines) const;
 

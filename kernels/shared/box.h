@@ -1,0 +1,50 @@
+/* Ray/box slab test of eight boxes in float8 lanes. OpenCL C only.
+ *
+ * ±0 direction components: the reciprocal of ±0 is ±inf, so a ray parallel
+ * to an axis gets slab distances (b - o) * inf = ±inf, exact for an origin
+ * strictly inside or outside the slab. An origin exactly on one of the
+ * slab's planes gives 0 * inf = NaN, and the fmin/fmax chain drops a NaN
+ * operand (OpenCL C 1.2, 6.12.2): that plane then does not limit the
+ * interval, which is exact too, since the ray stays on the closed slab for
+ * every t. Clamping |d| to a tiny finite value instead would reject a box
+ * whose face the ray lies on (tf = 0 * 1/eps = 0) for one sign of zero but
+ * not the other. */
+#ifndef RTCL_SHARED_BOX_H
+#define RTCL_SHARED_BOX_H
+
+#include "shared/ray.h"
+
+/* Relative widening of each slab interval at the robust and exact levels:
+ * covers the rounding of (b - o), of the reciprocal (<= 2.5 ulp in OpenCL C)
+ * and of the product, with margin (Ize 2013, "Robust BVH ray traversal").
+ * The fast level does not widen. */
+#define RTCL_SLAB_WIDEN (8.0f * FLT_EPSILON)
+
+inline void rtcl_widen_slab(float8* tn, float8* tf) {
+#ifndef RTCL_PRECISION_FAST
+  *tn = *tn - fabs(*tn) * RTCL_SLAB_WIDEN;
+  *tf = *tf + fabs(*tf) * RTCL_SLAB_WIDEN;
+#endif
+}
+
+/* Slab test of the ray against the node's eight child boxes over
+ * [tmin, tmax]. Returns the hit mask (lane = -1 where hit) and the entry
+ * distances. Empty slots (lower = +inf, upper = -inf) never hit. Each axis's
+ * distance enters a chain that starts from tmin or tmax, which are never
+ * NaN, so tn and tf are not either. */
+inline int8 intersect_boxes8(global const Bvh8Node* node, const TraceRay* s, float tmax, float8* t_entry) {
+  global const float8* b = (global const float8*)node->bounds;
+  float8 tnx = (b[s->near_x] - s->ox) * s->ix;
+  float8 tny = (b[s->near_y] - s->oy) * s->iy;
+  float8 tnz = (b[s->near_z] - s->oz) * s->iz;
+  float8 tfx = (b[s->far_x] - s->ox) * s->ix;
+  float8 tfy = (b[s->far_y] - s->oy) * s->iy;
+  float8 tfz = (b[s->far_z] - s->oz) * s->iz;
+  float8 tn = rtcl_fmax8(tnx, rtcl_fmax8(tny, rtcl_fmax8(tnz, (float8)(s->tmin))));
+  float8 tf = rtcl_fmin8(tfx, rtcl_fmin8(tfy, rtcl_fmin8(tfz, (float8)(tmax))));
+  rtcl_widen_slab(&tn, &tf);
+  *t_entry = tn;
+  return tn <= tf;
+}
+
+#endif

@@ -1,0 +1,164 @@
+/* Ray/triangle tests of eight triangles in float8 lanes, one ray: the one
+ * source of the arithmetic for every single-ray caller. Blocks
+ * (TriangleBlock, the BVH's leaves and brute force) and indexed references
+ * (cells and leaves that share primitives: grid, octree, kd-tree) load
+ * their lanes differently and then run intersect_triangle_lanes, so every
+ * structure reports the same closest t, bit for bit. OpenCL C only.
+ *
+ * Levels: robust and exact run the watertight test (Woop, Benthin, Wald
+ * 2013, JCGT 2(1)); exact re-tests in double what float cannot decide
+ * (shared/exact.h); fast runs Moller-Trumbore (1997), not watertight. */
+#ifndef RTCL_SHARED_TRIANGLE_H
+#define RTCL_SHARED_TRIANGLE_H
+
+#include "shared/exact.h"
+
+/* Edge function a*d - b*c; where the float result is exactly zero it is
+ * recomputed in double (Woop et al. 2013, section 4): a shared edge is then
+ * decided identically by both triangles that own it. */
+inline float8 rtcl_edge8(float8 a, float8 b, float8 c, float8 d) {
+  float8 e = a * d - b * c;
+#if defined(RTCL_HAS_FP64) && defined(RTCL_PRECISION_ROBUST)
+  if (any(e == 0.0f)) {
+    /* two double4 halves: double8 is not a native vector type on AVX2 */
+    double4 lo = convert_double4(a.lo) * convert_double4(d.lo) - convert_double4(b.lo) * convert_double4(c.lo);
+    double4 hi = convert_double4(a.hi) * convert_double4(d.hi) - convert_double4(b.hi) * convert_double4(c.hi);
+    float8 ed = (float8)(convert_float4(lo), convert_float4(hi));
+    e = select(e, ed, e == 0.0f);
+  }
+#endif
+  return e;
+}
+
+/* Moller-Trumbore, every argument per lane (a single-ray caller broadcasts
+ * its ray, a packet caller its triangle): the lanes hit in [tmin, t_best),
+ * with their t and barycentrics. No epsilon: det == 0 (ray in the plane) is
+ * the only rejection besides the barycentric and interval tests. */
+inline int8 rtcl_moller_trumbore8(float8 ax, float8 ay, float8 az, float8 bx, float8 by, float8 bz, float8 cx,
+                                  float8 cy, float8 cz, float8 ox, float8 oy, float8 oz, float8 dx, float8 dy,
+                                  float8 dz, float8 tmin, float8 t_best, float8* t, float8* u, float8* v) {
+  float8 e1x = bx - ax, e1y = by - ay, e1z = bz - az;
+  float8 e2x = cx - ax, e2y = cy - ay, e2z = cz - az;
+  float8 px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
+  float8 det = e1x * px + e1y * py + e1z * pz;
+  float8 inv = 1.0f / det;
+  float8 tx = ox - ax, ty = oy - ay, tz = oz - az;
+  *u = (tx * px + ty * py + tz * pz) * inv;
+  float8 qx = ty * e1z - tz * e1y, qy = tz * e1x - tx * e1z, qz = tx * e1y - ty * e1x;
+  *v = (dx * qx + dy * qy + dz * qz) * inv;
+  *t = (e2x * qx + e2y * qy + e2z * qz) * inv;
+  return (det != 0.0f) & (*u >= 0.0f) & (*v >= 0.0f) & (*u + *v <= 1.0f) & (*t >= tmin) & (*t < t_best);
+}
+
+/* Eight triangles against the ray: lane l is the triangle with vertices
+ * (a, b, c) given on the ray's permuted axes (kx, ky, kz): ax = a[kx], ...
+ * Lanes with NaN vertices never hit. If one is hit in [tmin, h->t_best)
+ * (at the exact level: beats h by exact_better), records the nearest in h
+ * and returns 1. */
+inline int intersect_triangle_lanes(float8 ax, float8 ay, float8 az, float8 bx, float8 by, float8 bz, float8 cx,
+                                    float8 cy, float8 cz, int8 prim, const TraceRay* s, HitState* h) {
+#ifdef RTCL_PRECISION_FAST
+  float8 t, u, v;
+  int8 ok = rtcl_moller_trumbore8(ax, ay, az, bx, by, bz, cx, cy, cz, (float8)(s->okx), (float8)(s->oky),
+                                  (float8)(s->okz), (float8)(s->dkx), (float8)(s->dky), (float8)(s->dkz),
+                                  (float8)(s->tmin), (float8)(h->t_best), &t, &u, &v);
+  if (!rtcl_any8(ok)) return 0;
+  float8 t_ok = select((float8)(INFINITY), t, ok);
+  float m = rtcl_min8(t_ok);
+  int lane = rtcl_lane_of(t_ok, m);
+  h->t_best = m;
+  h->u = rtcl_lane(u, lane);
+  h->v = rtcl_lane(v, lane);
+  h->prim = rtcl_lane_i(prim, lane);
+  return 1;
+#else
+  float8 Az = az - s->okz, Bz = bz - s->okz, Cz = cz - s->okz;
+  float8 Ax = ax - s->okx - s->sx * Az, Ay = ay - s->oky - s->sy * Az;
+  float8 Bx = bx - s->okx - s->sx * Bz, By = by - s->oky - s->sy * Bz;
+  float8 Cx = cx - s->okx - s->sx * Cz, Cy = cy - s->oky - s->sy * Cz;
+  float8 U = rtcl_edge8(Cx, Cy, Bx, By);
+  float8 V = rtcl_edge8(Ax, Ay, Cx, Cy);
+  float8 W = rtcl_edge8(Bx, By, Ax, Ay);
+#ifdef RTCL_PRECISION_EXACT
+  int8 cand = rtcl_exact_triangle_candidates(Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz, U, V, W, (float8)(s->sz),
+                                             (float8)(s->tmin), (float8)(h->t_best));
+  if (!rtcl_any8(cand)) return 0;
+  float va[9][8];
+  int c[8], p[8];
+  vstore8(ax, 0, va[0]); vstore8(ay, 0, va[1]); vstore8(az, 0, va[2]);
+  vstore8(bx, 0, va[3]); vstore8(by, 0, va[4]); vstore8(bz, 0, va[5]);
+  vstore8(cx, 0, va[6]); vstore8(cy, 0, va[7]); vstore8(cz, 0, va[8]);
+  vstore8(cand, 0, c);
+  vstore8(prim, 0, p);
+  int found = 0;
+  for (int l = 0; l < 8; ++l) {
+    if (!c[l]) continue;
+    double u = 0.0, v = 0.0;
+    double t = exact_triangle(va[0][l], va[1][l], va[2][l], va[3][l], va[4][l], va[5][l], va[6][l], va[7][l],
+                              va[8][l], s->okx, s->oky, s->okz, s->dkx, s->dky, s->dkz, &u, &v);
+    if (!exact_better(t, p[l], h->t_exact, h->prim, s->tmin, s->tmax)) continue;
+    h->t_exact = t;
+    h->t_best = convert_float_rtp(t);
+    h->u = (float)u;
+    h->v = (float)v;
+    h->prim = p[l];
+    found = 1;
+  }
+  return found;
+#else
+  int8 inside = ((U >= 0.0f) & (V >= 0.0f) & (W >= 0.0f)) | ((U <= 0.0f) & (V <= 0.0f) & (W <= 0.0f));
+  float8 det = U + V + W;
+  float8 T = s->sz * (U * Az + V * Bz + W * Cz);
+  float8 t = T / det;
+  int8 ok = inside & (det != 0.0f) & (t >= s->tmin) & (t < h->t_best);
+  if (!rtcl_any8(ok)) return 0;
+  float8 t_ok = select((float8)(INFINITY), t, ok);
+  float m = rtcl_min8(t_ok);
+  int lane = rtcl_lane_of(t_ok, m);
+  float inv_det = 1.0f / rtcl_lane(det, lane);
+  h->t_best = m;
+  h->u = rtcl_lane(V, lane) * inv_det;
+  h->v = rtcl_lane(W, lane) * inv_det;
+  h->prim = rtcl_lane_i(prim, lane);
+  return 1;
+#endif
+#endif
+}
+
+/* A block of eight triangles (v[vertex][axis][lane] rows: row 3*vertex+axis). */
+inline int intersect_triangles8(global const TriangleBlock* block, const TraceRay* s, HitState* h) {
+  global const float* v = &block->v[0][0][0];
+  return intersect_triangle_lanes(vload8(s->kx, v), vload8(s->ky, v), vload8(s->kz, v), vload8(3 + s->kx, v),
+                                  vload8(3 + s->ky, v), vload8(3 + s->kz, v), vload8(6 + s->kx, v),
+                                  vload8(6 + s->ky, v), vload8(6 + s->kz, v), vload8(0, block->prim), s, h);
+}
+
+/* Up to eight referenced triangles: refs[0 .. count) index the triangles of
+ * an id-ordered block array (reference r is lane r & 7 of block r >> 3, as
+ * make_primitive_blocks_in_order lays them out); count <= 8. Lanes past
+ * count are NaN and never hit. The same arithmetic as a block: the same
+ * closest t, bit for bit. */
+inline int intersect_triangle_refs(global const TriangleBlock* blocks, const int* refs, int count,
+                                   const TraceRay* s, HitState* h) {
+  float lanes[9][8];
+  int prim[8];
+  const int axis[3] = {s->kx, s->ky, s->kz};
+  for (int l = 0; l < 8; ++l) {
+    if (l < count) {
+      global const TriangleBlock* b = blocks + (refs[l] >> 3);
+      int lane = refs[l] & 7;
+      for (int j = 0; j < 3; ++j)
+        for (int k = 0; k < 3; ++k) lanes[3 * j + k][l] = b->v[j][axis[k]][lane];
+      prim[l] = b->prim[lane];
+    } else {
+      for (int r = 0; r < 9; ++r) lanes[r][l] = NAN;
+      prim[l] = -1;
+    }
+  }
+  return intersect_triangle_lanes(vload8(0, lanes[0]), vload8(0, lanes[1]), vload8(0, lanes[2]),
+                                  vload8(0, lanes[3]), vload8(0, lanes[4]), vload8(0, lanes[5]),
+                                  vload8(0, lanes[6]), vload8(0, lanes[7]), vload8(0, lanes[8]),
+                                  vload8(0, prim), s, h);
+}
+
+#endif
