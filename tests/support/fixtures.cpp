@@ -18,6 +18,13 @@ const Device& test_device() {
   return device;
 }
 
+std::vector<Precision> test_precisions() {
+  std::vector<Precision> levels;
+  for (Precision p : {Precision::robust, Precision::exact, Precision::fast})
+    if (precision_unsupported(test_device().info(), p).empty()) levels.push_back(p);
+  return levels;
+}
+
 std::string scene_path(const std::string& relative) { return std::string(RTCL_SCENE_DIR) + "/" + relative; }
 
 Geometry random_soup(std::size_t count, std::uint32_t seed, float size, float scale, glm::vec3 offset) {

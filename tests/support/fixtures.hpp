@@ -17,6 +17,10 @@ namespace rtcl::test {
 // is a failure (std::abort with a message), never a skip.
 const Device& test_device();
 
+// Every precision level the test device supports, robust first (exact
+// needs fp64: PoCL has it, so CI runs all three).
+std::vector<Precision> test_precisions();
+
 // Absolute path of a file under ../shared/scenes.
 std::string scene_path(const std::string& relative);
 
