@@ -30,6 +30,15 @@
  * from the origin. */
 #define RTCL_OFFSET_POINT 3.0f
 #define RTCL_OFFSET_EXTENT 16.0f
+/* The fast precision level's classic fixed offset instead (world units): right
+ * for scenes of about unit size, self-hits (acne) far from the origin,
+ * light leaking through thin walls at small scales. */
+#define RTCL_FIXED_OFFSET 1e-4f
+#ifdef RTCL_FIXED_SPAWN_OFFSET
+#define RTCL_SPAWN_OFFSET(p, extent) RTCL_FIXED_OFFSET
+#else
+#define RTCL_SPAWN_OFFSET(p, extent) (FLT_EPSILON * (RTCL_OFFSET_POINT * max3(fabs(p)) + RTCL_OFFSET_EXTENT * (extent)))
+#endif
 /* Shadow rays end this fraction of the distance before the light, so a
  * light placed on a surface still lights it (t is relative: scale-free). */
 #define RTCL_SHADOW_SHORTEN 1e-4f
@@ -55,7 +64,7 @@ inline SurfacePoint surface_point(const Ray r, const Hit h, global const ShadeTr
     float3 p = (float3)(r.ox, r.oy, r.oz) + h.t * (float3)(r.dx, r.dy, r.dz);
     s.ng = normalize(p - c);
     s.p = c + sp->radius * s.ng;
-    s.offset = FLT_EPSILON * (RTCL_OFFSET_POINT * max3(fabs(s.p)) + RTCL_OFFSET_EXTENT * sp->radius);
+    s.offset = RTCL_SPAWN_OFFSET(s.p, sp->radius);
     s.material = sp->material;
     return s;
   }
@@ -67,7 +76,7 @@ inline SurfacePoint surface_point(const Ray r, const Hit h, global const ShadeTr
   s.p = v0 + h.u * e1 + h.v * e2;
   float inv = 1.0f / extent; /* scaled before the cross product: no under/overflow at any scene scale */
   s.ng = normalize(cross(e1 * inv, e2 * inv));
-  s.offset = FLT_EPSILON * (RTCL_OFFSET_POINT * max3(fabs(s.p)) + RTCL_OFFSET_EXTENT * extent);
+  s.offset = RTCL_SPAWN_OFFSET(s.p, extent);
   s.material = t->material;
   return s;
 }

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "rtcl/accel/precision.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
 
@@ -40,6 +41,10 @@ void list() {
     std::printf("      version: %s\n", d.version.c_str());
     std::printf("      compute units: %u, global memory: %s, max allocation: %s, fp64: %s\n", d.compute_units,
                 human_bytes(d.global_mem_bytes).c_str(), human_bytes(d.max_alloc_bytes).c_str(), d.fp64 ? "yes" : "no");
+    std::string exact_note = precision_unsupported(d, Precision::exact);
+    std::printf("      precision levels: fast, robust, %s\n",
+                exact_note.empty() ? "exact (double-precision re-tests on the device)"
+                                   : ("no exact (" + exact_note + ")").c_str());
   }
 }
 

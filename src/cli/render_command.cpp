@@ -25,6 +25,7 @@ struct Options {
   std::string scene;
   std::string output = "render.png";
   std::string accel;
+  std::string precision;  // "": the scene file's, else robust
   std::string device;
   std::uint32_t width = 512, height = 0;  // height 0: from the camera's aspect
   std::uint32_t depth = 5, spp = 1;
@@ -86,9 +87,12 @@ void run(const Options& o) {
   settings.min_weight = o.min_weight;
   settings.batch_pixels = o.batch;
 
+  AccelConfig config;
+  config.precision = !o.precision.empty() ? parse_precision(o.precision) : scene.precision.value_or(Precision::robust);
   Device device = Device::open(o.device);
+  require_precision(device.info(), config.precision);
   std::string accel = o.accel.empty() ? default_accel() : o.accel;
-  Renderer renderer(device, scene, accel);
+  Renderer renderer(device, scene, accel, config);
   ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
   Image image = renderer.render(settings, [&](double f) { bar.update(f); });
   bar.finish();
@@ -96,11 +100,11 @@ void run(const Options& o) {
 
   const RenderStats& st = renderer.stats();
   const RayCounts& r = st.rays;
-  std::printf("rtcl render: %s (%ux%u, %u spp, depth %u, %s, %s): %llu camera + %llu shadow + %llu reflection + "
+  std::printf("rtcl render: %s (%ux%u, %u spp, depth %u, %s, %s precision, %s): %llu camera + %llu shadow + %llu reflection + "
               "%llu refraction = %llu rays in %.3f s, %.2f Mrays/s (trace only: camera %.2f, shadow %.2f, "
               "secondary %.2f Mrays/s)\n",
               o.output.c_str(), settings.width, settings.height, settings.spp, settings.max_depth, accel.c_str(),
-              device.info().name.c_str(), (unsigned long long)r.camera, (unsigned long long)r.shadow,
+              std::string(precision_name(config.precision)).c_str(), device.info().name.c_str(), (unsigned long long)r.camera, (unsigned long long)r.shadow,
               (unsigned long long)r.reflection, (unsigned long long)r.refraction, (unsigned long long)r.total(),
               st.render_ms * 1e-3, mrays(r.total(), st.render_ms), mrays(r.camera, st.camera_trace_ms),
               mrays(r.shadow, st.shadow_trace_ms), mrays(r.reflection + r.refraction, st.secondary_trace_ms));
@@ -126,6 +130,9 @@ void add_render_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--accel", o->accel, "Acceleration structure (default: bvh)")
       ->check(CLI::IsMember(accel_names()));
+  cmd->add_option("--precision", o->precision,
+                  "fast | robust | exact: the trace kernels' precision level and the spawn offsets (default: the "
+                  "scene file's \"precision\", else robust; see README, Precision levels)");
   cmd->add_option("--device", o->device, "OpenCL device: index or name substring (see `rtcl devices`)");
   cmd->add_option("--width", o->width, "Image width in pixels")->capture_default_str()->check(CLI::Range(1, 65536));
   cmd->add_option("--height", o->height, "Image height in pixels (default: width / the camera's aspect)")

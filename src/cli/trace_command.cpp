@@ -24,6 +24,7 @@ namespace {
 
 struct TraceOptions {
   std::string mesh, rays, hits, accel, device;
+  std::string precision = "robust";
   bool any = false;
   bool coherent = false;
 };
@@ -81,6 +82,8 @@ void run_trace(const TraceOptions& options) {
   std::vector<std::string> names = accel_names();
   if (std::find(names.begin(), names.end(), accel_name) == names.end())
     throw Error("--accel " + accel_name + ": unknown acceleration structure (known: " + joined(names) + ")");
+  AccelConfig config;
+  config.precision = parse_precision(options.precision);
   check_writable(options.hits);
 
   Clock::time_point load_start = Clock::now();
@@ -95,6 +98,7 @@ void run_trace(const TraceOptions& options) {
 
   Device device = Device::open(options.device);
   const DeviceInfo& info = device.info();
+  require_precision(info, config.precision);
   std::printf("device: [%zu] %s (%s)\n", info.index, info.name.c_str(), info.platform.c_str());
   std::printf("mesh:   %s: %zu triangles, %zu vertices, %zu objects, loaded in %.1f ms\n", options.mesh.c_str(),
               mesh.geometry.triangles.size(), mesh.geometry.vertices.size(), mesh.objects.size(), load_ms);
@@ -102,12 +106,13 @@ void run_trace(const TraceOptions& options) {
   std::fflush(stdout);
 
   Clock::time_point build_start = Clock::now();
-  std::unique_ptr<Accel> accel = make_accel(device, accel_name, mesh.geometry);
+  std::unique_ptr<Accel> accel = make_accel(device, accel_name, mesh.geometry, config);
   double setup_ms = ms_since(build_start);
   const AccelStats& stats = accel->stats();
   std::printf(
-      "accel:  %s: built in %.1f ms on the host (%.1f ms with kernel build and upload), %.1f MiB on the device\n",
-      accel->name().c_str(), stats.build_ms, setup_ms, static_cast<double>(stats.device_bytes) / 1048576.0);
+      "accel:  %s (%s precision): built in %.1f ms on the host (%.1f ms with kernel build and upload), %.1f MiB on "
+      "the device\n",
+      accel->name().c_str(), std::string(precision_name(config.precision)).c_str(), stats.build_ms, setup_ms, static_cast<double>(stats.device_bytes) / 1048576.0);
 
   Query query = options.any ? Query::any : Query::closest;
   Coherence coherence = options.coherent ? Coherence::coherent : Coherence::incoherent;
@@ -143,6 +148,10 @@ void add_trace_command(CLI::App& app) {
       ->required();
   cmd->add_option("--accel", options->accel,
                   "acceleration structure: " + joined(accel_names()) + " (default: " + default_accel() + ")");
+  cmd->add_option("--precision", options->precision,
+                  "fast | robust | exact: Moller-Trumbore and fast math / watertight (default) / watertight plus "
+                  "double-precision re-tests (see README, Precision levels)")
+      ->capture_default_str();
   cmd->add_option("--device", options->device,
                   "OpenCL device: index or name substring from `rtcl devices` (default: $RTCL_DEVICE, else 0)");
   cmd->add_flag("--any", options->any, "occlusion query: report any hit in [tmin, tmax], not the closest");

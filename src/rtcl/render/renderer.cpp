@@ -69,11 +69,12 @@ struct Renderer::State {
   State(const Device& d, const Scene& s) : device(d), scene(s), queue(d), next(d), shadows(d) {}
 };
 
-Renderer::Renderer(const Device& device, const Scene& scene, std::string_view accel_name)
+Renderer::Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config)
     : s_(std::make_unique<State>(device, scene)) {
   s_->flat = flatten(scene);
-  s_->accel = make_accel(device, accel_name, s_->flat.geometry);
+  s_->accel = make_accel(device, accel_name, s_->flat.geometry, config);
   s_->shading = upload_scene(device, scene, s_->flat);
+  if (config.precision == Precision::fast) s_->shading.defines.push_back("RTCL_FIXED_SPAWN_OFFSET");
   with_cl_errors([&] {
     cl::Program program = device.program("render/shade.cl", s_->shading.defines);
     s_->shade = cl::Kernel(program, "shade_hits");

@@ -73,8 +73,10 @@ using RenderProgress = std::function<void(double fraction)>;
 class Renderer {
  public:
   // Flattens and validates the scene, builds the named acceleration
-  // structure over it and the kernels specialised to it. Throws Error.
-  Renderer(const Device& device, const Scene& scene, std::string_view accel_name);
+  // structure over it (with `config`: its precision level also picks the
+  // spawn offsets, see kernels/render/shade.cl) and the kernels specialised
+  // to it. Throws Error.
+  Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config = {});
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;

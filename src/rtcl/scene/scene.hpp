@@ -7,10 +7,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "rtcl/accel/precision.hpp"
 
 #include "rtcl/scene/geometry.hpp"
 
@@ -71,6 +74,9 @@ struct Scene {
   std::vector<SceneMesh> meshes;
   std::vector<SceneSphere> spheres;
   std::vector<std::string> notes;  // things the user should know (mesh loader quirks), never errors
+  // "precision" of the scene file: the trace kernels' level and the spawn
+  // offsets (rtcl render --precision overrides it); none: robust.
+  std::optional<Precision> precision;
 };
 
 // Throws Error naming scene.source and the element for: a degenerate camera

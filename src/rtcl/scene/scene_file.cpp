@@ -178,11 +178,18 @@ class SceneBuilder {
   SceneBuilder(const Reader& r, std::filesystem::path base_dir) : r_(r), base_dir_(std::move(base_dir)) {}
 
   Scene build(const json& root) {
-    r_.object(root, "", {"camera", "ambient", "background", "lights", "materials", "objects"});
+    r_.object(root, "", {"camera", "ambient", "background", "lights", "materials", "objects", "precision"});
     scene_.source = r_.source();
     scene_.camera = read_camera(r_, r_.required(root, "", "camera"));
     if (root.contains("ambient")) scene_.ambient = colour(root["ambient"], "ambient");
     if (root.contains("background")) scene_.background = colour(root["background"], "background");
+    if (root.contains("precision")) {
+      std::string level = r_.string(root["precision"], "precision");
+      const auto& names = precision_names();
+      if (std::find(names.begin(), names.end(), level) == names.end())
+        r_.fail("precision", "unknown precision level '" + level + "' (known: fast, robust, exact)");
+      scene_.precision = parse_precision(level);
+    }
     if (root.contains("lights")) {
       const json& lights = root["lights"];
       if (!lights.is_array()) r_.fail("lights", std::string("expected an array, got ") + lights.type_name());
