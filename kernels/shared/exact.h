@@ -79,10 +79,11 @@ inline double exact_sphere(float cx, float cy, float cz, float r, float ox, floa
   return INFINITY;
 }
 
-/* Whether a double-precision hit at t on prim beats the best so far: finite
- * (a miss is +inf), inside [tmin, tmax], and nearer, or as near with the smaller primitive id. */
+/* Whether a double-precision hit at t on prim beats the best so far: a
+ * float t (a miss is +inf; beyond FLT_MAX no float hit can say it, as at the
+ * other levels), inside [tmin, tmax], and nearer, or as near with the smaller primitive id. */
 inline int exact_better(double t, int prim, double t_best, int prim_best, float tmin, float tmax) {
-  return t >= (double)tmin && t <= (double)tmax && t < (double)INFINITY && (t < t_best || (t == t_best && (prim_best < 0 || prim < prim_best)));
+  return t >= (double)tmin && t <= (double)tmax && t <= (double)FLT_MAX && (t < t_best || (t == t_best && (prim_best < 0 || prim < prim_best)));
 }
 
 #endif

@@ -162,6 +162,17 @@ class PlocBuilder {
         nearest_neighbours(c, config_.search_radius, 0, m / workers, nn);
         for (auto& t : pool) t.join();
       }
+      // Progress guarantee: inputs whose boxes all overlap alike (a fan of
+      // triangles around one shared vertex) form nearest-neighbour chains
+      // with a single mutual pair each, so clustering would take O(n)
+      // rounds; a round that would merge under 1/64 of the clusters pairs
+      // Morton neighbours instead (measured: 100k-triangle fan 21 s ->
+      // 0.3 s, rtcl trace --accel bvh-ploc; ordinary scenes merge 20-40% a round and
+      // never take this branch).
+      std::size_t mutual = 0;
+      for (std::size_t i = 0; i < m; ++i) mutual += nn[nn[i]] == i && nn[i] > i;
+      if (m >= 64 && mutual < m / 64)
+        for (std::size_t i = 0; i < m; ++i) nn[i] = static_cast<std::uint32_t>((i ^ 1u) < m ? i ^ 1u : i - 1);  // an odd last one waits
       next.resize(0);
       next.resize(m);
       std::size_t kept = 0;

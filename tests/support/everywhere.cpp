@@ -1,0 +1,105 @@
+#include "support/everywhere.hpp"
+
+#include <gtest/gtest-spi.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+#include <utility>
+
+#include "support/fixtures.hpp"
+#include "support/reference.hpp"
+
+namespace rtcl::test::everywhere {
+
+Ray make_ray(glm::vec3 o, glm::vec3 d, float tmin, float tmax) {
+  return {o.x, o.y, o.z, d.x, d.y, d.z, tmin, tmax};
+}
+
+std::string describe(const Ray& r) {
+  std::ostringstream s;
+  s.precision(9);
+  s << "o=(" << r.ox << "," << r.oy << "," << r.oz << ") d=(" << r.dx << "," << r.dy << "," << r.dz << ") t=["
+    << r.tmin << "," << r.tmax << "]";
+  return s.str();
+}
+
+std::string describe(const Hit& h) {
+  std::ostringstream s;
+  s.precision(9);
+  s << "prim " << h.prim << " t=" << h.t;
+  return s.str();
+}
+
+const char* query_name(Query q) { return q == Query::closest ? "closest" : "any"; }
+
+void expect_at_level(Precision level, bool must_pass, const std::string& what, const std::function<void()>& evaluate) {
+  if (level != Precision::fast || must_pass) return evaluate();
+  testing::TestPartResultArray results;
+  {
+    testing::ScopedFakeTestPartResultReporter reporter(
+        testing::ScopedFakeTestPartResultReporter::INTERCEPT_ONLY_CURRENT_THREAD, &results);
+    evaluate();
+  }
+  if (results.size() > 0) {
+    std::string first = results.GetTestPartResult(0).message();
+    std::replace(first.begin(), first.end(), '\n', ' ');
+    if (first.size() > 400) first = first.substr(0, 400) + "...";
+    std::printf("[fast] %s: %d expectation(s) not met (allowed at the fast level); first: %s\n", what.c_str(),
+                results.size(), first.c_str());
+  }
+}
+
+void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, const Check& check,
+                    RunOptions options) {
+  const Device& device = test_device();
+  for (Precision level : test_precisions()) {
+    AccelConfig config{level};
+    auto brute = make_accel(device, "brute", geometry, config);
+    std::vector<Hit> brute_hits[2] = {run_query(*brute, rays, Query::closest), run_query(*brute, rays, Query::any)};
+    for (const std::string& name : accel_names()) {
+      auto accel = name == "brute" ? nullptr : make_accel(device, name, geometry, config);
+      std::vector<std::pair<Coherence, Query>> calls = {{Coherence::incoherent, Query::closest},
+                                                        {Coherence::incoherent, Query::any}};
+      if (accel && accel->rays_per_work_item(Coherence::coherent) != accel->rays_per_work_item(Coherence::incoherent))
+        calls.insert(calls.end(), {{Coherence::coherent, Query::closest}, {Coherence::coherent, Query::any}});
+      for (auto [coherence, query] : calls) {
+        std::string what = name + " " + std::string(precision_name(level)) +
+                           (coherence == Coherence::coherent ? " coherent " : " ") + query_name(query) + " on " +
+                           geometry.source;
+        SCOPED_TRACE(what);
+        const std::vector<Hit>& expected = brute_hits[query == Query::closest ? 0 : 1];
+        std::vector<Hit> hits = accel ? run_query(*accel, rays, query, coherence) : expected;
+        expect_at_level(level, options.fast_must_pass, what, [&] {
+          std::size_t disagreements = 0, failures = 0;
+          std::string first, first_failure;
+          for (std::size_t i = 0; i < rays.size(); ++i) {
+            bool same = (hits[i].prim < 0) == (expected[i].prim < 0) &&
+                        (query == Query::any || hits[i].prim < 0 || hits[i].t == expected[i].t);
+            if (!same && disagreements++ == 0)
+              first = "ray " + std::to_string(i) + " " + describe(rays[i]) + ": " + describe(hits[i]) +
+                      ", brute force " + describe(expected[i]);
+            bool judged_already = !accel || (hits[i].prim == expected[i].prim && hits[i].t == expected[i].t);
+            if (options.judge && accel && !judged_already) {
+              std::string why = judge(geometry, rays[i], hits[i], query);
+              if (!why.empty() && failures++ == 0) first_failure = "ray " + describe(rays[i]) + ": " + why;
+            }
+          }
+          // fast builds each kernel with -cl-fast-relaxed-math: no bit-for-bit promise between structures
+          if (level != Precision::fast)
+            EXPECT_EQ(disagreements, 0u) << "disagreements with brute force of " << rays.size() << " rays; first: "
+                                         << first;
+          if (options.judge && !accel) {
+            auto report = judge_all(geometry, rays, hits, query, &failures);
+            if (!report.empty()) first_failure = report[0];
+          }
+          EXPECT_EQ(failures, 0u) << "answers the double-precision reference rejects; first: " << first_failure;
+          if (check) check(name, query, hits);
+        });
+      }
+    }
+  }
+}
+
+}  // namespace rtcl::test::everywhere
