@@ -82,7 +82,7 @@ TEST(Render, JitteredSamplesMatchReference) {
   RenderSettings s = small(24, 4);
   Scene scene = default_scene();
   ReferenceImage ref = reference_render(scene, s);
-  Renderer renderer(test_device(), scene, accel_names().back());
+  Renderer renderer(test_device(), scene, "bvh");
   ImageDifference d = compare_images(renderer.render(s), ref.image, ref.ambiguous);
   EXPECT_LE(d.max_error_unmasked, max_unambiguous_error);
   EXPECT_LE(d.rmse, max_rmse);
@@ -138,7 +138,7 @@ RenderSettings tree_settings(std::uint32_t depth) {
 }
 
 TEST(Refraction, RayThroughGlassSlabExitsParallelToItsEntry) {
-  Renderer renderer(test_device(), glass_slab(), accel_names().back());
+  Renderer renderer(test_device(), glass_slab(), "bvh");
   for (double angle : {0.0, 20.0, 45.0, 70.0}) {
     double a = glm::radians(angle);
     glm::dvec3 d0(std::sin(a), 0.3 * std::sin(a), -std::cos(a));
@@ -166,7 +166,7 @@ TEST(Refraction, RayThroughGlassSlabExitsParallelToItsEntry) {
 }
 
 TEST(Refraction, TotalInternalReflectionBeyondTheCriticalAngle) {
-  Renderer renderer(test_device(), glass_slab(), accel_names().back());
+  Renderer renderer(test_device(), glass_slab(), "bvh");
   const double critical = glm::degrees(std::asin(1.0 / 1.5));  // 41.81 degrees
   for (double angle : {critical + 0.5, 60.0, 80.0}) {
     double a = glm::radians(angle);
@@ -194,48 +194,76 @@ TEST(Refraction, TotalInternalReflectionBeyondTheCriticalAngle) {
 
 // --- scale and translation ----------------------------------------------------
 
-// The default scene moved far from its scale and from the origin renders the
-// same image: spawn offsets and shadow-ray ends scale with the scene, so
-// there is no acne (dark speckles on lit surfaces) and no lost or spurious
-// shadow: every pixel of a smooth region (walls, floor, shadow interiors)
-// keeps its value. Scaling keeps the geometry's relative precision: only
-// pixels whose centre falls exactly on an edge (the symmetric box's corners)
-// may change. At 1e5 from the origin floats are 0.0078 apart (0.4% of the
-// 2-unit box, 1/4 pixel here) and the spawn offset is 0.036 (about a pixel):
-// edges, grazing shadows and their reflections move by up to two pixels, so
-// pixels within two pixels of an edge may change.
-TEST(Render, ScaledAndTranslatedDefaultSceneRendersTheSameImage) {
+// The default scene moved far from its scale and from the origin, and a
+// grazing floor (where acne shows best), each against the double-precision
+// reference renderer of the same scene at the same scale: a test against the
+// renderer's own base-scale image could not see acne that scales with the
+// scene. Spawn offsets and shadow-ray ends scale with the scene, so there is
+// no acne (dark speckles on lit surfaces) and no lost or spurious shadow:
+// every pixel away from an edge matches. At 1e5 from the origin floats are
+// 0.0078 apart (0.4% of the 2-unit box, 1/4 pixel here) and the spawn
+// offset is 0.036 (about a pixel): edges, grazing shadows and their
+// reflections move by up to two pixels, so pixels within two pixels of an
+// edge of the reference image may differ.
+struct ScaleCase {
+  const char* what;
+  glm::dmat4 transform;
+  int edge_radius;              // pixels near an edge that may change
+  std::size_t max_pixels_over;  // of 4096, anywhere
+  // largest error away from edges: 1e-3 as for every render against the
+  // reference (expect_matches_reference); at 1e5 from the origin the spawn
+  // offset (0.036, 2% of the box) moves reflected and refracted origins
+  // visibly, so smooth regions may differ by up to 0.05 there
+  double max_smooth_error;
+};
+
+void expect_scaled_scene_matches_reference(const Scene& base, const ScaleCase& c, Precision level) {
   RenderSettings settings = small(64);
-  Scene base = default_scene();
-  const std::string accel = accel_names().back();
-  Image expected = Renderer(test_device(), base, accel).render(settings);
-  struct Case {
-    const char* what;
-    glm::dmat4 transform;
-    int edge_radius;              // pixels near an edge that may change
-    std::size_t max_pixels_over;  // of 4096, anywhere
-  };
-  const Case cases[] = {
-      {"scaled by 1e-4", glm::scale(glm::dmat4(1.0), glm::dvec3(1e-4)), 1, 41},
-      {"scaled by 1e5", glm::scale(glm::dmat4(1.0), glm::dvec3(1e5)), 1, 41},
-      {"translated by 1e5", glm::translate(glm::dmat4(1.0), glm::dvec3(1e5, -1e5, 1e5)), 2, 410},
-  };
-  for (const Case& c : cases) {
-    Image image = Renderer(test_device(), transform_scene(base, c.transform), accel).render(settings);
-    ImageDifference d = compare_images(image, expected, edge_pixels(expected, 0.05, c.edge_radius));
-    std::printf("[ measure  ] %s: rmse %.5f, max %.4f, over 0.05: %zu of 4096, %zu away from edges (%zu edge "
-                "pixels), max away from edges %.4f\n",
-                c.what, d.rmse, d.max_error, d.pixels_over, d.pixels_over_unmasked, d.masked_pixels,
-                d.max_error_unmasked);
-    EXPECT_EQ(d.pixels_over_unmasked, 0u) << c.what << ": a smooth region changed (acne or a lost shadow)";
-    EXPECT_LE(d.pixels_over, c.max_pixels_over) << c.what;
-  }
+  Scene scene = transform_scene(base, c.transform);
+  ReferenceImage ref = reference_render(scene, settings);
+  std::vector<std::uint8_t> excused = edge_pixels(ref.image, 0.05, c.edge_radius);
+  for (std::size_t i = 0; i < excused.size(); ++i) excused[i] |= ref.ambiguous[i];
+  Image image = Renderer(test_device(), scene, "bvh", {level}).render(settings);
+  ImageDifference d = compare_images(image, ref.image, excused);
+  std::string what = base.source + " " + c.what + " at " + std::string(precision_name(level));
+  std::printf("[ measure  ] %s: rmse %.5f, max %.4f, over 0.05: %zu of 4096, %zu away from edges (%zu excused), max "
+              "away from edges %.4f\n",
+              what.c_str(), d.rmse, d.max_error, d.pixels_over, d.pixels_over_unmasked, d.masked_pixels,
+              d.max_error_unmasked);
+  EXPECT_EQ(d.pixels_over_unmasked, 0u) << what << ": a smooth region differs from the reference (acne or a lost shadow)";
+  EXPECT_LE(d.max_error_unmasked, c.max_smooth_error) << what;
+  EXPECT_LE(d.pixels_over, c.max_pixels_over) << what;
 }
 
-// Acne shows best at grazing angles: a lit floor seen at 8 degrees, a sphere
-// on it, a light high above. In every version of the scene, each pixel must
-// be lit or shadowed as in the unmoved scene, but for the one-pixel band
-// around the sphere's silhouette and shadow edge.
+// The fast level's fixed spawn offset, measured (not asserted: acne and
+// light leaks at the extremes are that level's documented trade).
+void report_fast_level(const Scene& base, const ScaleCase& c) {
+  RenderSettings settings = small(64);
+  Scene scene = transform_scene(base, c.transform);
+  ReferenceImage ref = reference_render(scene, settings);
+  std::vector<std::uint8_t> excused = edge_pixels(ref.image, 0.05, c.edge_radius);
+  for (std::size_t i = 0; i < excused.size(); ++i) excused[i] |= ref.ambiguous[i];
+  Image image = Renderer(test_device(), scene, "bvh", {Precision::fast}).render(settings);
+  ImageDifference d = compare_images(image, ref.image, excused);
+  std::printf("[ measure  ] %s %s at fast: rmse %.5f, %zu of 4096 pixels off by > 0.05 away from edges\n",
+              base.source.c_str(), c.what, d.rmse, d.pixels_over_unmasked);
+}
+
+// At most 2% of the pixels off anywhere (edges, as in expect_matches_reference), 10% within two pixels of an
+// edge when translated.
+const ScaleCase kScaleCases[] = {
+    {"at scale 1", glm::dmat4(1.0), 1, 82, 1e-3},
+    {"scaled by 1e-4", glm::scale(glm::dmat4(1.0), glm::dvec3(1e-4)), 1, 82, 1e-3},
+    {"scaled by 1e5", glm::scale(glm::dmat4(1.0), glm::dvec3(1e5)), 1, 82, 1e-3},
+    {"translated by 1e5", glm::translate(glm::dmat4(1.0), glm::dvec3(1e5, -1e5, 1e5)), 2, 410, 0.05},
+};
+
+TEST(Render, ScaledAndTranslatedDefaultSceneMatchesTheReferenceAtThatScale) {
+  for (Precision level : {Precision::robust, Precision::exact})
+    for (const ScaleCase& c : kScaleCases) expect_scaled_scene_matches_reference(default_scene(), c, level);
+  for (const ScaleCase& c : kScaleCases) report_fast_level(default_scene(), c);
+}
+
 TEST(Render, NoShadowAcneAtGrazingAnglesAtAnyScale) {
   Scene base;
   base.source = "grazing floor";
@@ -252,26 +280,17 @@ TEST(Render, NoShadowAcneAtGrazingAnglesAtAnyScale) {
   base.lights.push_back(PointLight{{1.0f, 4.0f, -1.0f}, glm::vec3(1.0f), 1.0f});
   base.meshes.push_back(box_mesh({-30.0f, -1.0f, -30.0f}, {30.0f, 0.0f, 30.0f}, 0));
   base.spheres.push_back(SceneSphere{{0.0, 0.5, 0.0}, 0.5, 0});
-  RenderSettings settings = small(64);
-  const std::string accel = accel_names().back();
-  Image expected = Renderer(test_device(), base, accel).render(settings);
-  std::vector<std::uint8_t> edges = edge_pixels(expected, 0.05, 1);
-  const glm::dmat4 transforms[] = {glm::scale(glm::dmat4(1.0), glm::dvec3(1e-4)),
-                                   glm::scale(glm::dmat4(1.0), glm::dvec3(1e5)),
-                                   glm::translate(glm::dmat4(1.0), glm::dvec3(-1e5, 1e5, 1e5))};
-  for (const glm::dmat4& t : transforms) {
-    Image image = Renderer(test_device(), transform_scene(base, t), accel).render(settings);
-    ImageDifference d = compare_images(image, expected, edges);
-    EXPECT_EQ(d.pixels_over_unmasked, 0u) << "translation " << t[3][0] << ", scale " << t[0][0];
-    EXPECT_LE(d.max_error_unmasked, 0.01);
-  }
+  for (Precision level : {Precision::robust, Precision::exact})
+    for (const ScaleCase& c : kScaleCases)
+      expect_scaled_scene_matches_reference(base, {c.what, c.transform, c.edge_radius, 4096, c.max_smooth_error}, level);
+  for (const ScaleCase& c : kScaleCases) report_fast_level(base, c);
 }
 
 // --- determinism, knobs, specialisation -----------------------------------------
 
 TEST(Render, DeterministicAndIndependentOfBatchSize) {
   Scene scene = default_scene();
-  Renderer renderer(test_device(), scene, accel_names().front());
+  Renderer renderer(test_device(), scene, "bvh");
   RenderSettings s = small(40, 2);
   Image a = renderer.render(s);
   Image b = renderer.render(s);
@@ -283,7 +302,7 @@ TEST(Render, DeterministicAndIndependentOfBatchSize) {
 
 TEST(Render, DepthAndWeightThresholdTradeRaysForAccuracy) {
   Scene scene = default_scene();
-  Renderer renderer(test_device(), scene, accel_names().back());
+  Renderer renderer(test_device(), scene, "bvh");
   RenderSettings s = small(48);
   s.min_weight = 0.0f;
   Image full = renderer.render(s);

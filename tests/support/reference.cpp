@@ -74,6 +74,10 @@ PrimHit reference_intersect(const Geometry& g, std::uint32_t prim, const Ray& ra
   return intersect(g, prim, ray, tolerance_for(g, ray), false);
 }
 
+PrimHit reference_intersect(const Geometry& g, std::uint32_t prim, const Ray& ray, const Tolerance& tolerance) {
+  return intersect(g, prim, ray, tolerance, false);
+}
+
 namespace {
 
 // The scene's bounds cost a pass over every primitive: the functions below

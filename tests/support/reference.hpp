@@ -23,6 +23,10 @@ struct PrimHit {
 // Intersection with one primitive in double precision. For spheres, the
 // nearest root with t >= tmin - tolerance is reported.
 PrimHit reference_intersect(const Geometry& geometry, std::uint32_t prim, const Ray& ray);
+struct Tolerance;
+// The same with the ray's tolerance_for given (that costs a pass over the
+// scene: compute it once per ray when testing every primitive).
+PrimHit reference_intersect(const Geometry& geometry, std::uint32_t prim, const Ray& ray, const Tolerance& tolerance);
 
 struct Tolerance {
   double space;  // world units
