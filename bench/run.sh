@@ -38,3 +38,8 @@ export POCL_CACHE_DIR="${POCL_CACHE_DIR:-$build/pocl-cache-bench}"
   "$@"
 echo
 python3 "$root/bench/report.py" "$results/latest.json" -o "$results/latest.md"
+# Debian's python3 (with python3-matplotlib), whatever python3 is first on PATH
+if grep -q '"precision/' "$results/latest.json"; then
+  /usr/bin/python3 "$root/bench/precision_report.py" "$results/latest.json" -o "$results/precision.md" \
+    --plot "$results/precision.png"
+fi
