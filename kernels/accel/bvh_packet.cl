@@ -191,13 +191,13 @@ inline int8 packet_triangle(global const TriangleBlock* block, int k, const Trac
   int hit[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   for (int l = 0; l < 8; ++l) {
     if (!rtcl_lane_i(cand, l)) continue;
-    double u = 0.0, w = 0.0;
+    float u = 0.0f, w = 0.0f;
     double t = exact_triangle(rtcl_lane(v[0][0], l), rtcl_lane(v[0][1], l), rtcl_lane(v[0][2], l),
                               rtcl_lane(v[1][0], l), rtcl_lane(v[1][1], l), rtcl_lane(v[1][2], l),
                               rtcl_lane(v[2][0], l), rtcl_lane(v[2][1], l), rtcl_lane(v[2][2], l),
                               rtcl_lane(p->okx, l), rtcl_lane(p->oky, l), rtcl_lane(p->okz, l),
-                              rtcl_lane(p->dkx, l), rtcl_lane(p->dky, l), rtcl_lane(p->dkz, l), &u, &w);
-    hit[l] = -packet_exact_record(h, l, t, prim, rtcl_lane(p->tmin, l), rtcl_lane(p->tmax, l), (float)u, (float)w);
+                              exact_shear(rtcl_lane(p->dkx, l), rtcl_lane(p->dky, l), rtcl_lane(p->dkz, l)), &u, &w);
+    hit[l] = -packet_exact_record(h, l, t, prim, rtcl_lane(p->tmin, l), rtcl_lane(p->tmax, l), u, w);
   }
   return vload8(0, hit);
 #else

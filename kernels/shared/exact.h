@@ -8,10 +8,12 @@
 
 #ifdef RTCL_PRECISION_EXACT
 
-/* Relative bound, in units of FLT_EPSILON * R^2, on the float rounding error
- * of a shear-space edge function whose inputs have magnitude at most R
- * (each input: two or three rounded operations, the products and the
- * difference: a few ulps of R^2; 64 leaves a wide margin). */
+/* Bound, in units of FLT_EPSILON * R2 * R3, on the float rounding error of
+ * a shear-space edge function (U = Cx*By - Cy*Bx, ...), where R2 bounds the
+ * 2D sheared coordinates |Ax| .. |Cy| and R3 also |Az| .. |Cz|: each input
+ * (Ax = (ax - okx) - sx*Az) carries an error of about 2 eps (R2 + R3), the
+ * products multiply it by at most R2, and their difference adds eps R2^2:
+ * at most about 12 eps R2 R3; 64 leaves a wide margin. */
 #define RTCL_EXACT_EDGE_ULPS 64.0f
 /* Relative slack on a candidate's float t against tmin and the best t. */
 #define RTCL_EXACT_T_SLACK 1e-3f
@@ -23,9 +25,9 @@
 inline int8 rtcl_exact_triangle_candidates(float8 Ax, float8 Ay, float8 Az, float8 Bx, float8 By, float8 Bz,
                                            float8 Cx, float8 Cy, float8 Cz, float8 U, float8 V, float8 W,
                                            float8 sz, float8 tmin, float8 t_best) {
-  float8 R = fmax(fmax(fmax(fabs(Ax), fabs(Ay)), fmax(fabs(Bx), fabs(By))), fmax(fabs(Cx), fabs(Cy)));
-  R = fmax(R, fmax(fmax(fabs(Az), fabs(Bz)), fabs(Cz)));
-  float8 E = (RTCL_EXACT_EDGE_ULPS * FLT_EPSILON) * R * R;
+  float8 R2 = fmax(fmax(fmax(fabs(Ax), fabs(Ay)), fmax(fabs(Bx), fabs(By))), fmax(fabs(Cx), fabs(Cy)));
+  float8 R = fmax(R2, fmax(fmax(fabs(Az), fabs(Bz)), fabs(Cz)));
+  float8 E = (RTCL_EXACT_EDGE_ULPS * FLT_EPSILON) * R2 * R;
   int8 inside = ((U >= -E) & (V >= -E) & (W >= -E)) | ((U <= E) & (V <= E) & (W <= E));
   float8 det = U + V + W;
   float8 t = sz * (U * Az + V * Bz + W * Cz) / det;
@@ -34,15 +36,22 @@ inline int8 rtcl_exact_triangle_candidates(float8 Ax, float8 Ay, float8 Az, floa
   return inside & ((fabs(det) <= 4.0f * E) | near_range);
 }
 
+/* The shear constants of the watertight test in double, from the ray's
+ * permuted direction: one formula for every caller, so that single-ray and
+ * packet kernels agree bit for bit. */
+inline double3 exact_shear(float dkx, float dky, float dkz) {
+  double sz = 1.0 / (double)dkz;
+  return (double3)((double)dkx * sz, (double)dky * sz, sz);
+}
+
 /* The watertight test (Woop, Benthin, Wald 2013) in double for one triangle,
- * its vertices a, b, c given on the ray's permuted axes (kx, ky, kz) and the
- * ray as its permuted origin and direction. Returns t (+inf when the ray
- * misses or lies in the triangle's plane) and the barycentrics u, v. Inputs
- * are floats, so every difference of two of them is exact in double. */
+ * its vertices a, b, c given on the ray's permuted axes (kx, ky, kz), the
+ * ray as its permuted origin and its exact_shear. Returns t (+inf when the
+ * ray misses or lies in the triangle's plane) and the barycentrics u, v.
+ * Inputs are floats, so every difference of two of them is exact in double. */
 inline double exact_triangle(float ax, float ay, float az, float bx, float by, float bz, float cx, float cy,
-                             float cz, float okx, float oky, float okz, float dkx, float dky, float dkz, double* u,
-                             double* v) {
-  double sx = (double)dkx / (double)dkz, sy = (double)dky / (double)dkz, sz = 1.0 / (double)dkz;
+                             float cz, float okx, float oky, float okz, double3 shear, float* u, float* v) {
+  double sx = shear.x, sy = shear.y, sz = shear.z;
   double Az = (double)az - (double)okz, Bz = (double)bz - (double)okz, Cz = (double)cz - (double)okz;
   double Ax = (double)ax - (double)okx - sx * Az, Ay = (double)ay - (double)oky - sy * Az;
   double Bx = (double)bx - (double)okx - sx * Bz, By = (double)by - (double)oky - sy * Bz;
@@ -53,8 +62,9 @@ inline double exact_triangle(float ax, float ay, float az, float bx, float by, f
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return INFINITY;
   double det = U + V + W;
   if (det == 0.0) return INFINITY;
-  *u = V / det;
-  *v = W / det;
+  double inv = 1.0 / det; /* u, v need float accuracy only */
+  *u = (float)(V * inv);
+  *v = (float)(W * inv);
   return sz * (U * Az + V * Bz + W * Cz) / det;
 }
 

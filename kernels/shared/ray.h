@@ -43,6 +43,9 @@ typedef struct TraceRay {
   float okx, oky, okz;        /* origin, permuted */
   float dkx, dky, dkz;        /* direction, permuted */
   float dx, dy, dz;
+#ifdef RTCL_PRECISION_EXACT
+  double3 shear_exact; /* exact_shear of the permuted direction */
+#endif
 } TraceRay;
 
 /* Bit tests, immune to -cl-fast-relaxed-math (which lets the compiler
@@ -91,6 +94,10 @@ inline int trace_ray_setup(const Ray r, TraceRay* s) {
   s->sz = 1.0f / d[kz];
   s->okx = o[kx]; s->oky = o[ky]; s->okz = o[kz];
   s->dkx = d[kx]; s->dky = d[ky]; s->dkz = d[kz];
+#ifdef RTCL_PRECISION_EXACT
+  double sz = 1.0 / (double)d[kz]; /* exact_shear (shared/exact.h, which includes this file) */
+  s->shear_exact = (double3)((double)d[kx] * sz, (double)d[ky] * sz, sz);
+#endif
   return 1;
 }
 

@@ -93,14 +93,14 @@ inline int intersect_triangle_lanes(float8 ax, float8 ay, float8 az, float8 bx, 
   int found = 0;
   for (int l = 0; l < 8; ++l) {
     if (!c[l]) continue;
-    double u = 0.0, v = 0.0;
+    float u = 0.0f, v = 0.0f;
     double t = exact_triangle(va[0][l], va[1][l], va[2][l], va[3][l], va[4][l], va[5][l], va[6][l], va[7][l],
-                              va[8][l], s->okx, s->oky, s->okz, s->dkx, s->dky, s->dkz, &u, &v);
+                              va[8][l], s->okx, s->oky, s->okz, s->shear_exact, &u, &v);
     if (!exact_better(t, p[l], h->t_exact, h->prim, s->tmin, s->tmax)) continue;
     h->t_exact = t;
     h->t_best = convert_float_rtp(t);
-    h->u = (float)u;
-    h->v = (float)v;
+    h->u = u;
+    h->v = v;
     h->prim = p[l];
     found = 1;
   }
