@@ -250,3 +250,56 @@ TEST(CliErrors, FailureKeepsAnOldHitFile) {
 
 }  // namespace
 }  // namespace rtcl::test
+
+namespace rtcl::test {
+namespace {
+
+// --precision on both commands and "precision" in scene files.
+TEST(CliPrecision, EveryLevelTracesAndReportsItself) {
+  Inputs in;
+  Geometry g = load_mesh(in.mesh).geometry;
+  for (Precision level : test_precisions()) {
+    std::string name(precision_name(level));
+    CliRun run = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits", "--precision", name});
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_NE(run.out.find("(" + name + " precision)"), std::string::npos) << run.out;
+    std::vector<Hit> hits = read_hits(in.dir.file("out.hits"));
+    std::size_t failures = 0;
+    judge_all(g, in.ray_list, hits, Query::closest, &failures);
+    if (level != Precision::fast) EXPECT_EQ(failures, 0u) << name;
+  }
+}
+
+TEST(CliPrecision, UnknownLevelIsOneErrorAndNothingIsTraced) {
+  Inputs in;
+  CliRun trace = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits", "--precision", "precise"});
+  expect_failure(trace, "--precision precise: unknown precision level", in.dir, "out.hits");
+  EXPECT_EQ(trace.out.find("trace:"), std::string::npos) << trace.out;
+  CliRun render = run_cli(in.dir, {"render", "-q", "-o", "out.png", "--width", "16", "--precision", "precise"});
+  expect_failure(render, "--precision precise: unknown precision level", in.dir, "out.png");
+}
+
+TEST(CliPrecision, SceneFileLevelAndItsErrors) {
+  TempDir dir;
+  const std::string scene =
+      R"({"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0]}, "precision": "LEVEL",
+          "lights": [{"position": [0, 2, 2]}], "materials": {"grey": {}},
+          "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "grey"}]})";
+  auto with_level = [&](const std::string& level) {
+    std::string s = scene;
+    s.replace(s.find("LEVEL"), 5, level);
+    return dir.write("scene-" + level + ".json", s);
+  };
+  CliRun ok = run_cli(dir, {"render", with_level("exact"), "-q", "-o", "exact.png", "--width", "16"});
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find("exact precision"), std::string::npos) << ok.out;
+  CliRun overridden =
+      run_cli(dir, {"render", with_level("exact"), "-q", "-o", "fast.png", "--width", "16", "--precision", "fast"});
+  ASSERT_EQ(overridden.status, 0) << overridden.err;
+  EXPECT_NE(overridden.out.find("fast precision"), std::string::npos) << overridden.out;
+  expect_failure(run_cli(dir, {"render", with_level("wobbly"), "-q", "-o", "bad.png", "--width", "16"}),
+                 "precision: unknown precision level 'wobbly'", dir, "bad.png");
+}
+
+}  // namespace
+}  // namespace rtcl::test
