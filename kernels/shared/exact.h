@@ -79,10 +79,10 @@ inline double exact_sphere(float cx, float cy, float cz, float r, float ox, floa
   return INFINITY;
 }
 
-/* Whether a double-precision hit at t on prim beats the best so far: inside
- * [tmin, tmax], and nearer, or as near with the smaller primitive id. */
+/* Whether a double-precision hit at t on prim beats the best so far: finite
+ * (a miss is +inf), inside [tmin, tmax], and nearer, or as near with the smaller primitive id. */
 inline int exact_better(double t, int prim, double t_best, int prim_best, float tmin, float tmax) {
-  return t >= (double)tmin && t <= (double)tmax && (t < t_best || (t == t_best && (prim_best < 0 || prim < prim_best)));
+  return t >= (double)tmin && t <= (double)tmax && t < (double)INFINITY && (t < t_best || (t == t_best && (prim_best < 0 || prim < prim_best)));
 }
 
 #endif

@@ -5,6 +5,7 @@
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/accel/brute.hpp"
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/grid.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {
@@ -19,6 +20,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"bvh", make_bvh_sah},
       {"bvh-ploc", make_bvh_ploc},
       {"bvh-packet", make_bvh_packet},
+      {"grid", [](const Device& d, const Geometry& g, const AccelConfig& c) { return make_grid(d, g, {}, c); }},
   };
   return entries;
 }
