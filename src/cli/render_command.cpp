@@ -74,6 +74,7 @@ std::string join(const std::vector<std::string>& items) {
 double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? rays / (ms * 1e3) : 0.0; }
 
 void run(const Options& o) {
+  if (!o.accel.empty()) parse_accel_spec(o.accel);  // before the scene is loaded
   Scene scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
   for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   check_image_path(o.output);  // before the long work
@@ -87,7 +88,7 @@ void run(const Options& o) {
   settings.batch_pixels = o.batch;
 
   Device device = Device::open(o.device);
-  std::string accel = o.accel.empty() ? default_accel() : o.accel;
+  std::string accel = !o.accel.empty() ? o.accel : !scene.accel.empty() ? scene.accel : default_accel();
   Renderer renderer(device, scene, accel);
   ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
   Image image = renderer.render(settings, [&](double f) { bar.update(f); });
@@ -124,8 +125,9 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
                                             ".exr: linear float)")
       ->capture_default_str();
-  cmd->add_option("--accel", o->accel, "Acceleration structure (default: bvh)")
-      ->check(CLI::IsMember(accel_names()));
+  cmd->add_option("--accel", o->accel,
+                  "Acceleration structure, optionally with build options: NAME or NAME:key=value,... (default: "
+                  "the scene's \"accel\", else bvh; `rtcl structures` lists them)");
   cmd->add_option("--device", o->device, "OpenCL device: index or name substring (see `rtcl devices`)");
   cmd->add_option("--width", o->width, "Image width in pixels")->capture_default_str()->check(CLI::Range(1, 65536));
   cmd->add_option("--height", o->height, "Image height in pixels (default: width / the camera's aspect)")

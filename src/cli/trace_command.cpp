@@ -78,9 +78,7 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
 
 void run_trace(const TraceOptions& options) {
   std::string accel_name = options.accel.empty() ? default_accel() : options.accel;
-  std::vector<std::string> names = accel_names();
-  if (std::find(names.begin(), names.end(), accel_name) == names.end())
-    throw Error("--accel " + accel_name + ": unknown acceleration structure (known: " + joined(names) + ")");
+  parse_accel_spec(accel_name);  // name and options checked before any work
   check_writable(options.hits);
 
   Clock::time_point load_start = Clock::now();
@@ -142,7 +140,9 @@ void add_trace_command(CLI::App& app) {
                   "hit file to write: 16 bytes per ray, float32 t u v + int32 prim (miss: t=inf, prim=-1)")
       ->required();
   cmd->add_option("--accel", options->accel,
-                  "acceleration structure: " + joined(accel_names()) + " (default: " + default_accel() + ")");
+                  "acceleration structure: " + joined(accel_names()) + " (default: " + default_accel() +
+                      "), with build options as NAME:key=value,... e.g. grid:lambda=4 or grid:res=64x32x16 "
+                      "(`rtcl structures` lists every option and default)");
   cmd->add_option("--device", options->device,
                   "OpenCL device: index or name substring from `rtcl devices` (default: $RTCL_DEVICE, else 0)");
   cmd->add_flag("--any", options->any, "occlusion query: report any hit in [tmin, tmax], not the closest");

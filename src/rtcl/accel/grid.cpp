@@ -280,4 +280,23 @@ std::unique_ptr<Accel> make_grid(const Device& device, const Geometry& geometry,
   return std::make_unique<GridAccel>(device, geometry, grid, stats, accel_config);
 }
 
+const StructureSpec& grid_structure() {
+  static const StructureSpec spec{
+      "grid", "uniform grid, 3D-DDA traversal (Amanatides & Woo), exact triangle/cell overlap",
+      {{"lambda", OptionType::real, GridConfig{}.lambda, 0, 1024, true,
+        "cells per primitive (cells ~ lambda * N, split in proportion to the box): fewer cells make long cell "
+        "lists, more make many empty cells to walk and 4 bytes of offsets per cell"},
+       {"res", OptionType::resolution, GridResolution{0, 0, 0}, 1, 65536, false,
+        "explicit cells per axis AxBxC, overriding lambda; auto: from lambda"}}};
+  return spec;
+}
+
+std::unique_ptr<Accel> make_grid_accel(const Device& device, const Geometry& geometry, const AccelConfig& config) {
+  AccelOptions o = resolve_options(grid_structure(), config.options, "--accel grid");
+  GridConfig grid;
+  grid.lambda = o.real("lambda");
+  grid.resolution = o.resolution("res");
+  return make_grid(device, geometry, grid, config);
+}
+
 }  // namespace rtcl

@@ -56,6 +56,13 @@ GridResolution grid_resolution(const glm::dvec3& extent, std::size_t primitives,
 // a grid larger than config.max_alloc_bytes allows.
 Grid build_grid(const Geometry& geometry, const GridConfig& config = {});
 
+// Its registry entry: lambda (GridConfig::lambda) and res
+// (GridConfig::resolution, "auto" = from lambda).
+const StructureSpec& grid_structure();
+
+// The registered factory: make_grid configured by config.options.
+std::unique_ptr<Accel> make_grid_accel(const Device& device, const Geometry& geometry, const AccelConfig& config);
+
 // Builds and uploads; stats().build_ms covers build_grid.
 std::unique_ptr<Accel> make_grid(const Device& device, const Geometry& geometry, const GridConfig& config = {},
                                  const AccelConfig& accel_config = {});

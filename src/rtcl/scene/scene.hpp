@@ -71,6 +71,10 @@ struct Scene {
   std::vector<SceneMesh> meshes;
   std::vector<SceneSphere> spheres;
   std::vector<std::string> notes;  // things the user should know (mesh loader quirks), never errors
+  // "accel" of the scene file as a structure spec ("grid:lambda=4",
+  // rtcl/accel/options.hpp), checked when read: the structure rtcl render
+  // builds unless --accel is given. "" when the file names none.
+  std::string accel;
 };
 
 // Throws Error naming scene.source and the element for: a degenerate camera
