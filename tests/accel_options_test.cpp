@@ -11,6 +11,7 @@
 #include "rtcl/accel/grid.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/scene_file.hpp"
+#include "support/error_of.hpp"
 #include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 
@@ -18,12 +19,7 @@ namespace rtcl::test {
 namespace {
 
 std::string error_of_spec(const std::string& text) {
-  try {
-    parse_accel_spec(text);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return error_of([&] { parse_accel_spec(text); });
 }
 
 TEST(AccelOptions, EveryStructureIsDeclaredWithItsDefaults) {

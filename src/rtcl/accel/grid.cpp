@@ -45,9 +45,10 @@ struct Frame {
     };
     *lo = index(x0 - widen);
     *hi = index(x1 + widen);
-    while (*lo > 0 && plane(header, a, *lo) - widen > x0) --*lo;
+    // The division above may round across a plane: settle on the planes.
+    while (*lo > 0 && plane(header, a, *lo) + widen >= x0) --*lo;
     while (*lo < last && plane(header, a, *lo + 1) + widen < x0) ++*lo;
-    while (*hi < last && plane(header, a, *hi + 1) + widen <= x1) ++*hi;
+    while (*hi < last && plane(header, a, *hi + 1) - widen <= x1) ++*hi;
     while (*hi > *lo && plane(header, a, *hi) - widen > x1) --*hi;
   }
   glm::dvec3 cell_lower(std::int64_t i, std::int64_t j, std::int64_t k) const {

@@ -23,8 +23,13 @@ struct GridConfig {
   // Density: about lambda * N cells for N stored primitives, split in
   // proportion to the box's sides (Cleary & Wyvill 1988; Wald et al. 2006).
   // The lecture's trade-off: fewer cells make long lists, more make many
-  // empty cells to walk and more memory (README, "Uniform grid").
-  double lambda = 2.0;
+  // empty cells to walk and more memory. Measured (bench sweep/, PoCL, 2
+  // cores, README "Uniform grid"): time per ray is U-shaped in the cell
+  // count with its minimum at lambda 4..16 on bunny, sponza and sibenik
+  // (primary and diffuse rays); 8 was the best on three of those six sets,
+  // within 7% on two and 24% behind lambda 4 on the bunny's primary rays,
+  // at ~90 bytes per triangle (40 of them triangle blocks).
+  double lambda = 8.0;
   // Explicit resolution; overrides lambda when not {0, 0, 0}.
   GridResolution resolution{0, 0, 0};
   // Host threads for the overlap pass (0 = 2); the pass splits the
