@@ -6,7 +6,7 @@ packages=(
   build-essential cmake pkg-config ninja-build
   opencl-headers opencl-clhpp-headers ocl-icd-opencl-dev pocl-opencl-icd clinfo
   libglm-dev libopenimageio-dev openimageio-tools libassimp-dev nlohmann-json3-dev libcli11-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libembree-dev python3
+  libgtest-dev libgmock-dev libbenchmark-dev libembree-dev python3 python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do
