@@ -60,7 +60,8 @@ const std::vector<SceneSpec>& scene_specs() {
       {"teapot-stadium", "teapot/teapot.obj",
        {{0.0f, 4.0f, 10.0f}, {0.2f, 1.4f, 0.0f}, {0, 1, 0}, 50.0f},
        {5.0f, 10.0f, 8.0f},
-       100.0f},
+       100.0f,
+       16384},
   };
   return specs;
 }

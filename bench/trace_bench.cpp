@@ -107,7 +107,9 @@ void trace_benchmark(benchmark::State& state, const std::string& scene_name, Ray
     auto scene = bench_scene(scene_name);
     DeviceScene& device_scene = DeviceScene::get(scene);
     const Accel& accel = device_scene.accel(accel_name);
-    std::size_t limit = accel_name == "brute" ? brute_ray_limit() : 0;
+    std::size_t limit = accel_name == "brute"                 ? brute_ray_limit()
+                        : accel_name.rfind("grid", 0) == 0 ? scene->spec->grid_ray_limit
+                                                           : 0;
     const DeviceScene::Rays& rays = device_scene.rays(kind, limit);
     std::size_t count = rays.host->rays.size();
     Query query = ray_kind_query(kind);

@@ -3,7 +3,7 @@
  * (均匀格点). The ray is clipped to the grid box, its first cell found from
  * the entry point, and then cells are visited in the order it crosses them.
  *
- * Stepping: integer cell coordinates (i0, i1, i2); per axis the direction's
+ * Stepping: integer cell coordinates cell_x, cell_y, cell_z; per axis the direction's
  * sign `step` (0 for a zero component: that axis never steps and its t_next
  * is FLT_MAX, no division by zero, no inf or NaN) and t_next, the distance
  * to the cell's exit plane on that axis, recomputed from the integer index
