@@ -39,7 +39,8 @@ Query ray_kind_query(RayKind kind) {
 // bunny (0.16 units, faces +z) and dragon (14 units long, side view from +z):
 // seen from the front, the model filling most of the square view. sponza:
 // from the floor at one end of the atrium looking along it (x axis); sibenik:
-// from the entrance end of the nave towards the apse (+x).
+// from the entrance end of the nave towards the apse (+x). teapot-stadium:
+// the teapot from the front and above, inside its stadium.
 const std::vector<SceneSpec>& scene_specs() {
   static const std::vector<SceneSpec> specs = {
       {"bunny", "stanford_bunny/bunny.obj",
@@ -54,6 +55,13 @@ const std::vector<SceneSpec>& scene_specs() {
       {"sibenik", "sibenik/sibenik.obj",
        {{-17.0f, -11.0f, 0.0f}, {0.0f, -9.0f, 0.0f}, {0, 1, 0}, 60.0f},
        {-2.0f, -3.0f, 0.0f}},
+      // The teapot (6.4 units wide) in a box 100 times its size; the camera
+      // sees it and the far walls around it.
+      {"teapot-stadium", "teapot/teapot.obj",
+       {{0.0f, 4.0f, 10.0f}, {0.2f, 1.4f, 0.0f}, {0, 1, 0}, 50.0f},
+       {5.0f, 10.0f, 8.0f},
+       100.0f,
+       16384},
   };
   return specs;
 }
@@ -111,12 +119,30 @@ class Oracle {
 #endif
 };
 
+// Appends a closed box around the geometry, `scale` times its largest side
+// (12 triangles facing inwards).
+void add_stadium(Geometry& g, float scale) {
+  Aabb box = g.bounds();
+  glm::vec3 extent = box.extent();
+  float half = 0.5f * scale * std::max({extent.x, extent.y, extent.z});
+  glm::vec3 c = box.center();
+  auto first = static_cast<std::uint32_t>(g.vertices.size());
+  for (int i = 0; i < 8; ++i)
+    g.vertices.push_back(c + half * glm::vec3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f));
+  const std::uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    g.triangles.push_back(glm::uvec3(first + q[0], first + q[1], first + q[2]));
+    g.triangles.push_back(glm::uvec3(first + q[0], first + q[2], first + q[3]));
+  }
+}
+
 std::shared_ptr<const BenchScene> load_scene(const SceneSpec& spec) {
   auto scene = std::make_shared<BenchScene>();
   scene->spec = &spec;
   auto start = std::chrono::steady_clock::now();
   LoadedMesh mesh = load_mesh(scenes_dir() + "/" + spec.file);
   scene->geometry = std::move(mesh.geometry);
+  if (spec.stadium > 0.0f) add_stadium(scene->geometry, spec.stadium);
   validate(scene->geometry);
   scene->load_ms = ms_since(start);
 

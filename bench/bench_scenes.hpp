@@ -47,9 +47,17 @@ struct SceneSpec {
   std::string file;  // relative to scenes_dir()
   Camera camera;
   glm::vec3 light;   // point light position, scene units
+  // > 0: the mesh stands inside a closed box (12 triangles) this many times
+  // its largest side, centred on it: the "teapot in a stadium", a scene
+  // whose primitives fill a tiny part of its box.
+  float stadium = 0.0f;
+  // > 0: the grid (trace/ and sweep/) traces a subset, every k-th ray, at
+  // most this many, as brute force does: where it is ~1000x slower than the
+  // BVH (the teapot in its stadium) a full set would take minutes a launch.
+  std::size_t grid_ray_limit = 0;
 };
 
-// bunny, dragon, sponza, sibenik, in that order.
+// bunny, dragon, sponza, sibenik, teapot-stadium, in that order.
 const std::vector<SceneSpec>& scene_specs();
 
 // $RTCL_SCENES_DIR, else the ../shared/scenes beside the source tree.

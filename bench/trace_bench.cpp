@@ -3,6 +3,9 @@
 //   trace/<scene>/<kind>/<accel>   kernel time of one launch over the ray set; kinds:
 //     primary, shadow, diffuse (pixel order) and primary-tiled, shadow-morton,
 //     diffuse-morton (the same rays reordered for packets)
+//   sweep/<scene>/<kind>/grid/<option>=<value>   the same for the grid built
+//     with that option (lambda=..., res=AxBxC): the lecture's trade-off of
+//     cell count against list length (bench/plot_sweep.py plots it)
 // Kernel time comes from OpenCL event profiling (COMMAND_START .. COMMAND_END)
 // and is reported as manual time; a warm-up launch first absorbs PoCL's
 // compile-on-first-launch. Brute force traces a subset (brute_ray_limit()).
@@ -50,8 +53,8 @@ class DeviceScene {
   // size as the timed ones, since PoCL generates code at the first launch of
   // each work-group size, checked against the reference so that a wrong
   // structure cannot look fast. Returns agreement() of that launch.
-  double warm_up(const Accel& accel, RayKind kind, const Rays& rays) {
-    auto key = std::make_pair(accel.name(), kind);
+  double warm_up(const std::string& spec, const Accel& accel, RayKind kind, const Rays& rays) {
+    auto key = std::make_pair(spec, kind);
     if (auto it = agreement_.find(key); it != agreement_.end()) return it->second;
     std::size_t count = rays.host->rays.size();
     Query query = ray_kind_query(kind);
@@ -104,12 +107,14 @@ void trace_benchmark(benchmark::State& state, const std::string& scene_name, Ray
     auto scene = bench_scene(scene_name);
     DeviceScene& device_scene = DeviceScene::get(scene);
     const Accel& accel = device_scene.accel(accel_name);
-    std::size_t limit = accel_name == "brute" ? brute_ray_limit() : 0;
+    std::size_t limit = accel_name == "brute"                 ? brute_ray_limit()
+                        : accel_name.rfind("grid", 0) == 0 ? scene->spec->grid_ray_limit
+                                                           : 0;
     const DeviceScene::Rays& rays = device_scene.rays(kind, limit);
     std::size_t count = rays.host->rays.size();
     Query query = ray_kind_query(kind);
 
-    double agree = device_scene.warm_up(accel, kind, rays);
+    double agree = device_scene.warm_up(accel_name, accel, kind, rays);
 
     for (auto _ : state) {
       cl::Event done = accel.trace(query, rays.rays, rays.hits, count);
@@ -122,6 +127,8 @@ void trace_benchmark(benchmark::State& state, const std::string& scene_name, Ray
     state.counters["agree"] = agree;
     state.counters["bytes_per_tri"] = bytes_per_triangle(accel.stats(), scene->triangle_count());
     state.counters["build_ms"] = accel.stats().build_ms;
+    state.counters["device_bytes"] = static_cast<double>(accel.stats().device_bytes);
+    state.counters["cells"] = static_cast<double>(accel.stats().node_count);
     state.SetLabel(accel.device().info().name);
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
@@ -165,6 +172,25 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
       benchmark::RegisterBenchmark(
           ("trace/" + spec.name + "/" + ray_kind_name(kind) + "/" + accel).c_str(), trace_benchmark, spec.name,
           kind, accel)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond);
+});
+
+// The grid's density sweep: lambda from 1/8 to 64 cells per primitive, and
+// cubic resolutions, on the ray kinds below; the BVH of the same run is
+// trace/<scene>/<kind>/bvh.
+[[maybe_unused]] const bool sweep_registered = add_scene_hook([](const SceneSpec& spec) {
+  if (spec.name == "dragon") return;
+  const char* lambdas[] = {"0.125", "0.25", "0.5", "1", "2", "4", "8", "16", "32", "64"};
+  const char* cubes[] = {"16x16x16", "32x32x32", "64x64x64", "128x128x128", "256x256x256"};
+  std::vector<std::string> options;
+  for (const char* l : lambdas) options.push_back(std::string("lambda=") + l);
+  for (const char* r : cubes) options.push_back(std::string("res=") + r);
+  for (RayKind kind : {RayKind::primary, RayKind::diffuse})
+    for (const std::string& option : options)
+      benchmark::RegisterBenchmark(
+          ("sweep/" + spec.name + "/" + ray_kind_name(kind) + "/grid/" + option).c_str(), trace_benchmark,
+          spec.name, kind, "grid:" + option)
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond);
 });

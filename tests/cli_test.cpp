@@ -301,5 +301,32 @@ TEST(CliPrecision, SceneFileLevelAndItsErrors) {
                  "precision: unknown precision level 'wobbly'", dir, "bad.png");
 }
 
+TEST(CliStructures, ListsEveryStructureWithItsOptions) {
+  TempDir dir;
+  CliRun run = run_cli(dir, {"structures"});
+  ASSERT_EQ(run.status, 0) << run.err;
+  for (const StructureSpec& s : structure_specs()) {
+    EXPECT_NE(run.out.find(s.name + "  "), std::string::npos) << s.name;
+    for (const OptionSpec& o : s.options) EXPECT_NE(run.out.find(o.name), std::string::npos) << o.name;
+  }
+  EXPECT_NE(run.out.find("default auto"), std::string::npos) << run.out;
+}
+
+TEST(CliStructures, TraceTakesStructureOptionsAndRejectsBadOnes) {
+  Inputs in;
+  Geometry g = load_mesh(in.mesh).geometry;
+  CliRun run = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "grid.hits", "--accel", "grid:res=3x2x5"});
+  ASSERT_EQ(run.status, 0) << run.err;
+  std::vector<Hit> hits = read_hits(in.dir.file("grid.hits"));
+  std::size_t failures = 0;
+  auto report = judge_all(g, in.ray_list, hits, Query::closest, &failures);
+  EXPECT_EQ(failures, 0u) << (report.empty() ? "" : report[0]);
+  expect_failure(run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "bad.hits", "--accel", "grid:lambda=-1"}),
+                 "--accel grid:lambda=-1: lambda must be > 0", in.dir, "bad.hits");
+  expect_failure(run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "bad.hits", "--accel", "grid:depth=3"}),
+                 "unknown option depth", in.dir, "bad.hits");
+  expect_failure(run_cli(in.dir, {"render", "-o", "bad.png", "--accel", "grid:res=0x1x1"}), "res must be", in.dir);
+}
+
 }  // namespace
 }  // namespace rtcl::test

@@ -68,6 +68,21 @@ typedef struct Bvh8Node {
 #define RTCL_LEAF_TRIANGLES(block) (~((rtcl_i32)(block) << 1))
 #define RTCL_LEAF_SPHERES(block) (~(((rtcl_i32)(block) << 1) | 1))
 
+/* A uniform grid (kernels/accel/grid.cl): res[0] x res[1] x res[2] cells
+ * over the box [lower, lower + res * cell]. Cell (i, j, k) is the closed box
+ * from lower + (i, j, k) * cell to lower + (i + 1, j + 1, k + 1) * cell, each
+ * coordinate computed in float as lower[a] + (float)n * cell[a] by host and
+ * kernel alike; its index is i + res[0] * (j + res[1] * k). Its references
+ * are refs[cell_begin[c] .. cell_begin[c + 1]) (compact grid, Lagae & Dutre
+ * 2008): triangles first, as r >= 0 (lane r & 7 of triangle block r >> 3,
+ * id-ordered blocks), then spheres, as ~r < 0 (sphere block array). 48 bytes;
+ * element [3] of each row is unused. */
+typedef struct GridHeader {
+  float lower[4];
+  float cell[4];  /* cell size per axis, > 0 */
+  rtcl_i32 res[4]; /* cells per axis, >= 1 */
+} GridHeader;
+
 #ifndef __OPENCL_VERSION__
 } /* namespace rtcl */
 #endif

@@ -10,6 +10,7 @@ int main(int argc, char** argv) {
   rtcl::cli::add_devices_command(app);
   rtcl::cli::add_trace_command(app);
   rtcl::cli::add_render_command(app);
+  rtcl::cli::add_structures_command(app);
   if (argc < 2) {  // no subcommand: show what there is, and fail
     app.name("rtcl");
     std::fputs(app.help().c_str(), stderr);

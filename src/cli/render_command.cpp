@@ -75,6 +75,7 @@ std::string join(const std::vector<std::string>& items) {
 double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? rays / (ms * 1e3) : 0.0; }
 
 void run(const Options& o) {
+  if (!o.accel.empty()) parse_accel_spec(o.accel);  // before the scene is loaded
   Scene scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
   for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   check_image_path(o.output);  // before the long work
@@ -91,7 +92,7 @@ void run(const Options& o) {
   config.precision = !o.precision.empty() ? parse_precision(o.precision) : scene.precision.value_or(Precision::robust);
   Device device = Device::open(o.device);
   require_precision(device.info(), config.precision);
-  std::string accel = o.accel.empty() ? default_accel() : o.accel;
+  std::string accel = !o.accel.empty() ? o.accel : !scene.accel.empty() ? scene.accel : default_accel();
   Renderer renderer(device, scene, accel, config);
   ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
   Image image = renderer.render(settings, [&](double f) { bar.update(f); });
@@ -128,8 +129,9 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
                                             ".exr: linear float)")
       ->capture_default_str();
-  cmd->add_option("--accel", o->accel, "Acceleration structure (default: bvh)")
-      ->check(CLI::IsMember(accel_names()));
+  cmd->add_option("--accel", o->accel,
+                  "Acceleration structure, optionally with build options: NAME or NAME:key=value,... (default: "
+                  "the scene's \"accel\", else bvh; `rtcl structures` lists them)");
   cmd->add_option("--precision", o->precision,
                   "fast | robust | exact: the trace kernels' precision level and the spawn offsets (default: the "
                   "scene file's \"precision\", else robust; see README, Precision levels)");

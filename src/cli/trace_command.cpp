@@ -79,9 +79,7 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
 
 void run_trace(const TraceOptions& options) {
   std::string accel_name = options.accel.empty() ? default_accel() : options.accel;
-  std::vector<std::string> names = accel_names();
-  if (std::find(names.begin(), names.end(), accel_name) == names.end())
-    throw Error("--accel " + accel_name + ": unknown acceleration structure (known: " + joined(names) + ")");
+  parse_accel_spec(accel_name);  // name and options checked before any work
   AccelConfig config;
   config.precision = parse_precision(options.precision);
   check_writable(options.hits);
@@ -147,7 +145,9 @@ void add_trace_command(CLI::App& app) {
                   "hit file to write: 16 bytes per ray, float32 t u v + int32 prim (miss: t=inf, prim=-1)")
       ->required();
   cmd->add_option("--accel", options->accel,
-                  "acceleration structure: " + joined(accel_names()) + " (default: " + default_accel() + ")");
+                  "acceleration structure: " + joined(accel_names()) + " (default: " + default_accel() +
+                      "), with build options as NAME:key=value,... e.g. grid:lambda=4 or grid:res=64x32x16 "
+                      "(`rtcl structures` lists every option and default)");
   cmd->add_option("--precision", options->precision,
                   "fast | robust | exact: Moller-Trumbore and fast math / watertight (default) / watertight plus "
                   "double-precision re-tests (see README, Precision levels)")

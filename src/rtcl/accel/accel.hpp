@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rtcl/accel/options.hpp"
 #include "rtcl/accel/precision.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/scene/geometry.hpp"
@@ -40,6 +41,10 @@ enum class Coherence {
 // How a structure is built and which kernels it compiles.
 struct AccelConfig {
   Precision precision = Precision::robust;
+  // The structure's build options (rtcl/accel/options.hpp), checked against
+  // its declaration by make_accel; absent ones take the declared defaults
+  // (`rtcl structures` lists them).
+  AccelOptions options;
 };
 
 struct AccelStats {
@@ -130,9 +135,12 @@ class Accel {
 // Names make_accel accepts, in the order benchmarks list them.
 std::vector<std::string> accel_names();
 
-// Builds the named structure over validated geometry and uploads it.
-// Throws Error naming the accel when the name is unknown, and naming
-// --precision when the device cannot run config.precision.
+// Builds the named structure over validated geometry and uploads it. `name`
+// is a structure name or a spec with options, "grid:lambda=4,res=64x32x16"
+// (parse_accel_spec); config.options are applied after the spec's. Throws
+// Error naming the accel when the name is unknown or an option is unknown,
+// of the wrong type or out of range, and naming --precision when the device
+// cannot run config.precision.
 std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry,
                                   const AccelConfig& config = {});
 

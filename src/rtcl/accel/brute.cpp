@@ -33,6 +33,11 @@ class BruteAccel final : public Accel {
 
 }  // namespace
 
+const StructureSpec& brute_structure() {
+  static const StructureSpec spec{"brute", "every ray against every primitive, 8 per block (the device reference)", {}};
+  return spec;
+}
+
 std::unique_ptr<Accel> make_brute(const Device& device, const Geometry& geometry, const AccelConfig& config) {
   auto start = std::chrono::steady_clock::now();
   GeometryReport report = validate(geometry);

@@ -87,9 +87,15 @@ std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size);
 std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config = {},
                                 std::string name = "bvh", const AccelConfig& accel_config = {});
 
-// The registered structures: "bvh" (binned SAH, default config),
-// "bvh-ploc" (PLOC, default config) and "bvh-packet" (binned SAH,
-// BvhTraversal::packet).
+// Their registry entries; the options set the SahConfig / PlocConfig fields
+// of the same name and BvhConfig::merge_leaves.
+const StructureSpec& bvh_structure();
+const StructureSpec& bvh_ploc_structure();
+const StructureSpec& bvh_packet_structure();
+
+// The registered structures: "bvh" (binned SAH), "bvh-ploc" (PLOC) and
+// "bvh-packet" (binned SAH, BvhTraversal::packet), configured by
+// config.options (defaults: the config structs' defaults).
 std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry, const AccelConfig& config);
 std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry, const AccelConfig& config);
 std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry, const AccelConfig& config);

@@ -1,10 +1,12 @@
 // The one list of structures make_accel knows. A new structure adds its
-// builder file, its kernel file and one line here.
+// builder file (with its StructureSpec: name, summary, options), its kernel
+// file and one line here.
 #include <functional>
 
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/accel/brute.hpp"
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/grid.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {
@@ -13,12 +15,18 @@ namespace {
 
 using Factory = std::function<std::unique_ptr<Accel>(const Device&, const Geometry&, const AccelConfig&)>;
 
-const std::vector<std::pair<std::string, Factory>>& registry() {
-  static const std::vector<std::pair<std::string, Factory>> entries = {
-      {"brute", [](const Device& d, const Geometry& g, const AccelConfig& c) { return make_brute(d, g, c); }},
-      {"bvh", make_bvh_sah},
-      {"bvh-ploc", make_bvh_ploc},
-      {"bvh-packet", make_bvh_packet},
+struct Entry {
+  const StructureSpec& spec;
+  Factory make;
+};
+
+const std::vector<Entry>& registry() {
+  static const std::vector<Entry> entries = {
+      {brute_structure(), [](const Device& d, const Geometry& g, const AccelConfig& c) { return make_brute(d, g, c); }},
+      {bvh_structure(), make_bvh_sah},
+      {bvh_ploc_structure(), make_bvh_ploc},
+      {bvh_packet_structure(), make_bvh_packet},
+      {grid_structure(), make_grid_accel},
   };
   return entries;
 }
@@ -27,20 +35,38 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
 
 std::vector<std::string> accel_names() {
   std::vector<std::string> names;
-  for (const auto& entry : registry()) names.push_back(entry.first);
+  for (const Entry& entry : registry()) names.push_back(entry.spec.name);
   return names;
+}
+
+const std::vector<StructureSpec>& structure_specs() {
+  static const std::vector<StructureSpec> specs = [] {
+    std::vector<StructureSpec> out;
+    for (const Entry& entry : registry()) out.push_back(entry.spec);
+    return out;
+  }();
+  return specs;
+}
+
+const StructureSpec& structure_spec(std::string_view name) {
+  for (const Entry& entry : registry())
+    if (entry.spec.name == name) return entry.spec;
+  std::string known;
+  for (const Entry& entry : registry()) known += (known.empty() ? "" : ", ") + entry.spec.name;
+  throw Error("--accel " + std::string(name) + ": unknown acceleration structure (known: " + known + ")");
 }
 
 std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry,
                                   const AccelConfig& config) {
-  for (const auto& entry : registry())
-    if (entry.first == name) {
-      require_precision(device.info(), config.precision);
-      return entry.second(device, geometry, config);
-    }
-  std::string known;
-  for (const auto& entry : registry()) known += (known.empty() ? "" : ", ") + entry.first;
-  throw Error("--accel " + std::string(name) + ": unknown acceleration structure (known: " + known + ")");
+  AccelSpec spec = parse_accel_spec(name);
+  AccelConfig full = config;
+  full.options = spec.options;
+  for (const auto& [option, value] : config.options.values()) full.options.set(option, value);
+  full.options = resolve_options(structure_spec(spec.name), full.options, "--accel " + std::string(name));
+  require_precision(device.info(), config.precision);
+  for (const Entry& entry : registry())
+    if (entry.spec.name == spec.name) return entry.make(device, geometry, full);
+  throw Error("internal: structure " + spec.name + " has no factory");
 }
 
 }  // namespace rtcl

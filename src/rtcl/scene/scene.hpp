@@ -77,6 +77,10 @@ struct Scene {
   // "precision" of the scene file: the trace kernels' level and the spawn
   // offsets (rtcl render --precision overrides it); none: robust.
   std::optional<Precision> precision;
+  // "accel" of the scene file as a structure spec ("grid:lambda=4",
+  // rtcl/accel/options.hpp), checked when read: the structure rtcl render
+  // builds unless --accel is given. "" when the file names none.
+  std::string accel;
 };
 
 // Throws Error naming scene.source and the element for: a degenerate camera

@@ -11,6 +11,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
+#include "rtcl/accel/options.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {
@@ -172,14 +173,39 @@ Material read_material(const Reader& r, const json& v, const std::string& name, 
   }
   return m;
 }
+// "accel": a spec string ("grid:lambda=4") or an object {"name": "grid",
+// "lambda": 4, "res": [64, 32, 16] or "64x32x16"}; returned as the checked
+// spec text (format_accel_spec).
+std::string read_accel(const Reader& r, const json& v) {
+  const std::string where = r.source() + ": accel";
+  if (v.is_string()) return format_accel_spec(parse_accel_spec(v.get<std::string>(), where));
+  if (!v.is_object()) r.fail("accel", std::string("expected a string or an object, got ") + v.type_name());
+  std::string text = r.string(r.required(v, "accel", "name"), "accel.name");
+  char sep = ':';
+  for (const auto& item : v.items()) {
+    if (item.key() == "name") continue;
+    const json& x = item.value();
+    std::string value;
+    if (x.is_string()) value = x.get<std::string>();
+    else if (x.is_boolean() || x.is_number()) value = x.dump();
+    else if (x.is_array() && x.size() == 3 && x[0].is_number_integer() && x[1].is_number_integer() &&
+             x[2].is_number_integer())
+      value = x[0].dump() + "x" + x[1].dump() + "x" + x[2].dump();
+    else r.fail("accel." + item.key(), std::string("expected a number, boolean, string or [a, b, c], got ") + x.type_name());
+    text += sep + item.key() + "=" + value;
+    sep = ',';
+  }
+  return format_accel_spec(parse_accel_spec(text, where));
+}
 
 class SceneBuilder {
  public:
   SceneBuilder(const Reader& r, std::filesystem::path base_dir) : r_(r), base_dir_(std::move(base_dir)) {}
 
   Scene build(const json& root) {
-    r_.object(root, "", {"camera", "ambient", "background", "lights", "materials", "objects", "precision"});
+    r_.object(root, "", {"camera", "ambient", "background", "lights", "materials", "objects", "accel", "precision"});
     scene_.source = r_.source();
+    if (root.contains("accel")) scene_.accel = read_accel(r_, root["accel"]);
     scene_.camera = read_camera(r_, r_.required(root, "", "camera"));
     if (root.contains("ambient")) scene_.ambient = colour(root["ambient"], "ambient");
     if (root.contains("background")) scene_.background = colour(root["background"], "background");

@@ -1,0 +1,303 @@
+#include "rtcl/accel/grid.hpp"
+
+#include <algorithm>
+#include <cfloat>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <thread>
+
+#include "rtcl/bounds/overlap.hpp"
+#include "rtcl/error.hpp"
+
+namespace rtcl {
+
+namespace {
+
+constexpr double kMaxAxisCells = 65536.0;
+// Cell indices are int on the device: cells < 2^31.
+constexpr std::uint64_t kMaxCells = 0x7fffffffu;
+
+std::string resolution_text(const GridResolution& r) {
+  return std::to_string(r[0]) + "x" + std::to_string(r[1]) + "x" + std::to_string(r[2]);
+}
+
+// The float coordinate of cell plane n on axis a, exactly as the kernel
+// computes it (GridHeader contract).
+float plane(const GridHeader& g, int a, std::int64_t n) { return g.lower[a] + static_cast<float>(n) * g.cell[a]; }
+
+// Where the build works: the header, and the widening of every cell box for
+// the overlap tests. The widening (64 float ulps of the scene's magnitude)
+// covers the rounding of the kernel's cell planes, slab distances and hit
+// points, so that a primitive touching or nearly touching a cell boundary is
+// listed in the cells on both sides.
+struct Frame {
+  GridHeader header{};
+  double widen = 0.0;
+
+  // Cells [lo, hi] on axis a whose widened slabs meet [x0, x1].
+  void range(int a, double x0, double x1, std::int64_t* lo, std::int64_t* hi) const {
+    std::int64_t last = header.res[a] - 1;
+    auto index = [&](double x) {
+      double f = std::floor((x - header.lower[a]) / header.cell[a]);
+      return static_cast<std::int64_t>(std::clamp(f, 0.0, static_cast<double>(last)));
+    };
+    *lo = index(x0 - widen);
+    *hi = index(x1 + widen);
+    // The division above may round across a plane: settle on the planes.
+    while (*lo > 0 && plane(header, a, *lo) + widen >= x0) --*lo;
+    while (*lo < last && plane(header, a, *lo + 1) + widen < x0) ++*lo;
+    while (*hi < last && plane(header, a, *hi + 1) - widen <= x1) ++*hi;
+    while (*hi > *lo && plane(header, a, *hi) - widen > x1) --*hi;
+  }
+  glm::dvec3 cell_lower(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    return glm::dvec3(plane(header, 0, i), plane(header, 1, j), plane(header, 2, k)) - widen;
+  }
+  glm::dvec3 cell_upper(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    return glm::dvec3(plane(header, 0, i + 1), plane(header, 1, j + 1), plane(header, 2, k + 1)) + widen;
+  }
+  std::uint32_t cell_index(std::int64_t i, std::int64_t j, std::int64_t k) const {
+    return static_cast<std::uint32_t>(i + header.res[0] * (j + static_cast<std::int64_t>(header.res[1]) * k));
+  }
+};
+
+struct CellRef {
+  std::uint32_t cell;
+  rtcl_i32 ref;
+};
+
+// Appends (cell, ref) for every cell the primitive with this box overlaps;
+// `overlaps(lower, upper)` decides cells of boxes that the box alone cannot.
+template <class Overlaps>
+void emit(const Frame& f, const glm::dvec3& lower, const glm::dvec3& upper, rtcl_i32 ref, bool test_always,
+          const Overlaps& overlaps, std::vector<CellRef>& out) {
+  std::int64_t lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) f.range(a, lower[a], upper[a], &lo[a], &hi[a]);
+  // A convex primitive whose box lies within one slab on two axes meets
+  // every cell of its range along the third: no test needed.
+  int spanning = (hi[0] > lo[0]) + (hi[1] > lo[1]) + (hi[2] > lo[2]);
+  bool test = test_always || spanning >= 2;
+  for (std::int64_t k = lo[2]; k <= hi[2]; ++k)
+    for (std::int64_t j = lo[1]; j <= hi[1]; ++j)
+      for (std::int64_t i = lo[0]; i <= hi[0]; ++i)
+        if (!test || overlaps(f.cell_lower(i, j, k), f.cell_upper(i, j, k))) out.push_back({f.cell_index(i, j, k), ref});
+}
+
+[[noreturn]] void too_large(const Geometry& g, const std::string& option, const std::string& what, std::uint64_t bytes,
+                            std::size_t limit) {
+  throw Error("grid over " + g.source + ": " + option + ": " + what + " need " + std::to_string(bytes) +
+              " bytes, more than the device's largest buffer (" + std::to_string(limit) +
+              " bytes, CL_DEVICE_MAX_MEM_ALLOC_SIZE); use a smaller lambda or res");
+}
+
+Frame make_frame(const Geometry& geometry, const GridConfig& config, std::size_t primitives, std::string* option) {
+  if (!(config.lambda > 0.0) || !std::isfinite(config.lambda))
+    throw Error("grid: lambda must be > 0 (got " + std::to_string(config.lambda) + ")");
+  bool explicit_res = config.resolution != GridResolution{0, 0, 0};
+  for (std::uint32_t r : config.resolution)
+    if (explicit_res && (r < 1 || r > kMaxAxisCells))
+      throw Error("grid: res=" + resolution_text(config.resolution) + ": every axis must be in [1, 65536]");
+  *option = explicit_res ? "res=" + resolution_text(config.resolution) : "lambda=" + std::to_string(config.lambda);
+
+  Aabb box = geometry.bounds();
+  glm::dvec3 lower(box.lower), upper(box.upper);
+  double magnitude = 0.0;
+  for (int a = 0; a < 3; ++a) magnitude = std::max({magnitude, std::fabs(lower[a]), std::fabs(upper[a])});
+  double pad = std::max(16.0 * FLT_EPSILON * magnitude, static_cast<double>(FLT_MIN));
+  Frame f;
+  f.widen = 64.0 * FLT_EPSILON * magnitude + static_cast<double>(FLT_MIN);
+  GridResolution res = explicit_res ? config.resolution : grid_resolution(upper - lower, primitives, config.lambda);
+  std::uint64_t cells = std::uint64_t(res[0]) * res[1] * res[2];
+  if (cells > kMaxCells)
+    throw Error("grid over " + geometry.source + ": " + *option + ": " + resolution_text(res) + " = " +
+                std::to_string(cells) + " cells, more than the 2^31-1 the kernel can index");
+  if (config.max_alloc_bytes && (cells + 1) * sizeof(rtcl_u32) > config.max_alloc_bytes)
+    too_large(geometry, *option, resolution_text(res) + " cell offsets", (cells + 1) * sizeof(rtcl_u32),
+              config.max_alloc_bytes);
+  for (int a = 0; a < 3; ++a) {
+    // Rounded outwards: the grid box contains the padded scene box.
+    float lo = std::nextafter(static_cast<float>(lower[a] - pad), -std::numeric_limits<float>::infinity());
+    double hi = upper[a] + pad;
+    float cell = std::nextafter(static_cast<float>((hi - lo) / res[a]), std::numeric_limits<float>::infinity());
+    f.header.lower[a] = lo;
+    f.header.res[a] = static_cast<rtcl_i32>(res[a]);
+    f.header.cell[a] = cell;
+    while (plane(f.header, a, res[a]) < hi) f.header.cell[a] = std::nextafter(f.header.cell[a], FLT_MAX);
+  }
+  return f;
+}
+
+}  // namespace
+
+std::size_t Grid::bytes() const {
+  return sizeof(GridHeader) + cell_begin.size() * sizeof(rtcl_u32) + refs.size() * sizeof(rtcl_i32) + blocks.bytes();
+}
+
+GridResolution grid_resolution(const glm::dvec3& extent, std::size_t primitives, double lambda) {
+  // r_a = extent_a * k with prod(r_a) = lambda * N over the axes still
+  // free; an axis that would get less than one cell gets one and leaves
+  // the budget to the others.
+  double target = std::max(1.0, lambda * static_cast<double>(primitives));
+  bool free_axis[3] = {extent.x > 0.0, extent.y > 0.0, extent.z > 0.0};
+  GridResolution res{1, 1, 1};
+  for (int round = 0; round < 3; ++round) {
+    double volume = 1.0;
+    int dims = 0;
+    for (int a = 0; a < 3; ++a)
+      if (free_axis[a]) volume *= extent[a], ++dims;
+    if (dims == 0) break;
+    double k = std::pow(target / volume, 1.0 / dims);
+    bool changed = false;
+    for (int a = 0; a < 3; ++a) {
+      if (!free_axis[a]) continue;
+      double r = extent[a] * k;
+      if (r < 1.0) {
+        free_axis[a] = false;
+        res[a] = 1;
+        changed = true;
+      } else {
+        res[a] = static_cast<std::uint32_t>(std::min(kMaxAxisCells, std::max(1.0, std::round(r))));
+      }
+    }
+    if (!changed) break;
+  }
+  return res;
+}
+
+Grid build_grid(const Geometry& geometry, const GridConfig& config) {
+  std::vector<std::uint32_t> ids = stored_primitives(geometry);
+  std::string option;
+  Frame f = make_frame(geometry, config, ids.size(), &option);
+  std::size_t triangle_count = ids.size() - geometry.spheres.size();
+  std::size_t max_refs = config.max_alloc_bytes ? config.max_alloc_bytes / sizeof(rtcl_i32) : kMaxCells;
+  max_refs = std::min<std::size_t>(max_refs, kMaxCells);
+
+  // Pass 1 (parallel over contiguous triangle ranges): (cell, ref) pairs.
+  unsigned threads = config.thread_count ? config.thread_count : 2;
+  if (triangle_count < 4096) threads = 1;
+  std::vector<std::vector<CellRef>> parts(threads + 1);
+  std::vector<char> overflow(threads + 1, 0);
+  auto triangles = [&](unsigned part) {
+    std::size_t begin = triangle_count * part / threads, end = triangle_count * (part + 1) / threads;
+    std::vector<CellRef>& out = parts[part];
+    out.reserve((end - begin) * 4);
+    for (std::size_t k = begin; k < end; ++k) {
+      const glm::uvec3& t = geometry.triangles[ids[k]];
+      glm::dvec3 a(geometry.vertices[t.x]), b(geometry.vertices[t.y]), c(geometry.vertices[t.z]);
+      glm::dvec3 lower = glm::min(a, glm::min(b, c)), upper = glm::max(a, glm::max(b, c));
+      emit(f, lower, upper, static_cast<rtcl_i32>(k), false,
+           [&](const glm::dvec3& lo, const glm::dvec3& hi) {
+             return triangle_box_overlap(a, b, c, 0.5 * (lo + hi), 0.5 * (hi - lo));
+           },
+           out);
+      if (out.size() > max_refs) {
+        overflow[part] = 1;
+        return;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned part = 1; part < threads; ++part) pool.emplace_back(triangles, part);
+  triangles(0);
+  for (std::thread& t : pool) t.join();
+  for (std::size_t j = 0; j < geometry.spheres.size(); ++j) {
+    const Sphere& s = geometry.spheres[j];
+    glm::dvec3 center(s.center);
+    double r = s.radius;
+    emit(f, center - r, center + r, ~static_cast<rtcl_i32>(j), true,
+         [&](const glm::dvec3& lo, const glm::dvec3& hi) { return sphere_box_overlap(center, r, lo, hi); },
+         parts[threads]);
+  }
+  std::size_t ref_count = 0;
+  for (const auto& p : parts) ref_count += p.size();
+  if (ref_count > max_refs || std::find(overflow.begin(), overflow.end(), 1) != overflow.end())
+    too_large(geometry, option, "more than " + std::to_string(max_refs) + " cell references",
+              std::uint64_t(max_refs + 1) * sizeof(rtcl_i32), max_refs * sizeof(rtcl_i32));
+
+  // Pass 2: counting sort by cell, stable (triangles, in id order, before
+  // spheres in every cell).
+  Grid grid;
+  grid.header = f.header;
+  std::size_t cells = std::size_t(f.header.res[0]) * f.header.res[1] * f.header.res[2];
+  grid.cell_begin.assign(cells + 1, 0);
+  for (const auto& p : parts)
+    for (const CellRef& r : p) ++grid.cell_begin[r.cell + 1];
+  for (std::size_t c = 0; c < cells; ++c) grid.cell_begin[c + 1] += grid.cell_begin[c];
+  grid.refs.resize(ref_count);
+  std::vector<rtcl_u32> next(grid.cell_begin.begin(), grid.cell_begin.end() - 1);
+  for (const auto& p : parts)
+    for (const CellRef& r : p) grid.refs[next[r.cell]++] = r.ref;
+  grid.blocks = in_order_blocks(geometry, ids);
+  return grid;
+}
+
+namespace {
+
+class GridAccel final : public Accel {
+ public:
+  GridAccel(const Device& device, const Geometry& geometry, const Grid& grid, AccelStats stats,
+            const AccelConfig& config)
+      : Accel(device, "grid", {"accel/grid.cl"}, std::nullopt, primitive_defines(geometry), stats, config),
+        header_(device.upload(&grid.header, sizeof grid.header, "grid header")),
+        cell_begin_(device.upload(grid.cell_begin.data(), grid.cell_begin.size() * sizeof(rtcl_u32),
+                                  "grid cell offsets")),
+        refs_(grid.refs.empty() ? device.upload(&kNoRef, sizeof kNoRef, "grid references")
+                                : device.upload(grid.refs.data(), grid.refs.size() * sizeof(rtcl_i32),
+                                                "grid references")),
+        primitives_(upload(device, grid.blocks)) {}
+
+ private:
+  static constexpr rtcl_i32 kNoRef = 0;
+
+  void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
+    kernel.setArg(first, header_);
+    kernel.setArg(first + 1, cell_begin_);
+    kernel.setArg(first + 2, refs_);
+    kernel.setArg(first + 3, primitives_.triangles);
+    kernel.setArg(first + 4, primitives_.spheres);
+  }
+
+  cl::Buffer header_, cell_begin_, refs_;
+  DevicePrimitives primitives_;
+};
+
+}  // namespace
+
+std::unique_ptr<Accel> make_grid(const Device& device, const Geometry& geometry, const GridConfig& config,
+                                 const AccelConfig& accel_config) {
+  auto start = std::chrono::steady_clock::now();
+  GeometryReport report = validate(geometry);
+  GridConfig limited = config;
+  if (!limited.max_alloc_bytes) limited.max_alloc_bytes = device.info().max_alloc_bytes;
+  Grid grid = build_grid(geometry, limited);
+  AccelStats stats;
+  stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats.device_bytes = grid.bytes();
+  stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
+  stats.zero_area_skipped = report.zero_area_triangles;
+  stats.node_count = grid.cell_count();
+  stats.leaf_count = grid.blocks.triangles.size() + grid.blocks.spheres.size();
+  return std::make_unique<GridAccel>(device, geometry, grid, stats, accel_config);
+}
+
+const StructureSpec& grid_structure() {
+  static const StructureSpec spec{
+      "grid", "uniform grid, 3D-DDA traversal (Amanatides & Woo), exact triangle/cell overlap",
+      {{"lambda", OptionType::real, GridConfig{}.lambda, 0, 1024, true,
+        "cells per primitive (cells ~ lambda * N, split in proportion to the box): fewer cells make long cell "
+        "lists, more make many empty cells to walk and 4 bytes of offsets per cell"},
+       {"res", OptionType::resolution, GridResolution{0, 0, 0}, 1, 65536, false,
+        "explicit cells per axis AxBxC, overriding lambda; auto: from lambda"}}};
+  return spec;
+}
+
+std::unique_ptr<Accel> make_grid_accel(const Device& device, const Geometry& geometry, const AccelConfig& config) {
+  AccelOptions o = resolve_options(grid_structure(), config.options, "--accel grid");
+  GridConfig grid;
+  grid.lambda = o.real("lambda");
+  grid.resolution = o.resolution("res");
+  return make_grid(device, geometry, grid, config);
+}
+
+}  // namespace rtcl

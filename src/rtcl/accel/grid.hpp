@@ -1,0 +1,75 @@
+// Uniform grid (lecture: 均匀格点, Uniform Grids): a 3D array of cells over the
+// scene box, each listing the primitives that overlap it, stored compactly
+// (per-cell offsets plus one reference array, Lagae & Dutre 2008) and walked
+// by a 3D-DDA (Amanatides & Woo 1987) in kernels/accel/grid.cl.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel/primitive_blocks.hpp"
+#include "rtcl/layouts.hpp"
+
+namespace rtcl {
+
+// Cells per axis (x, y, z), each >= 1; {0, 0, 0} means "from the density".
+using GridResolution = std::array<std::uint32_t, 3>;
+
+struct GridConfig {
+  // Density: about lambda * N cells for N stored primitives, split in
+  // proportion to the box's sides (Cleary & Wyvill 1988; Wald et al. 2006).
+  // The lecture's trade-off: fewer cells make long lists, more make many
+  // empty cells to walk and more memory. Measured (bench sweep/, PoCL, 2
+  // cores, README "Uniform grid"): time per ray is U-shaped in the cell
+  // count with its minimum at lambda 4..16 on bunny, sponza and sibenik
+  // (primary and diffuse rays); 8 was the best on three of those six sets,
+  // within 7% on two and 24% behind lambda 4 on the bunny's primary rays,
+  // at ~90 bytes per triangle (40 of them triangle blocks).
+  double lambda = 8.0;
+  // Explicit resolution; overrides lambda when not {0, 0, 0}.
+  GridResolution resolution{0, 0, 0};
+  // Host threads for the overlap pass (0 = 2); the pass splits the
+  // triangles into this many contiguous ranges.
+  unsigned thread_count = 0;
+  // The largest buffer the device can allocate (0: no limit); a grid whose
+  // cell offsets or reference list would exceed it is refused before the
+  // overlap pass, or as soon as the count is known.
+  std::size_t max_alloc_bytes = 0;
+};
+
+// The host image of what the kernel reads (kernels/shared/layouts.h).
+struct Grid {
+  GridHeader header{};
+  std::vector<rtcl_u32> cell_begin;  // cells + 1 offsets into refs
+  std::vector<rtcl_i32> refs;        // per cell: triangle refs k >= 0, then sphere refs ~j
+  PrimitiveBlocks blocks;            // stored primitives in id order (in_order_blocks)
+  std::size_t cell_count() const { return cell_begin.empty() ? 0 : cell_begin.size() - 1; }
+  std::size_t bytes() const;         // everything the device holds
+};
+
+// The density heuristic: cells ~ lambda * primitives, r_a proportional to
+// extent[a]; an axis of (near) zero extent gets 1 cell and the others share
+// the budget. Each axis is clamped to [1, 65536].
+GridResolution grid_resolution(const glm::dvec3& extent, std::size_t primitives, double lambda);
+
+// Builds the grid over the stored primitives of validated geometry. Throws
+// Error naming the option (lambda, res) for a bad config, and the limit for
+// a grid larger than config.max_alloc_bytes allows.
+Grid build_grid(const Geometry& geometry, const GridConfig& config = {});
+
+// Its registry entry: lambda (GridConfig::lambda) and res
+// (GridConfig::resolution, "auto" = from lambda).
+const StructureSpec& grid_structure();
+
+// The registered factory: make_grid configured by config.options.
+std::unique_ptr<Accel> make_grid_accel(const Device& device, const Geometry& geometry, const AccelConfig& config);
+
+// Builds and uploads; stats().build_ms covers build_grid.
+std::unique_ptr<Accel> make_grid(const Device& device, const Geometry& geometry, const GridConfig& config = {},
+                                 const AccelConfig& accel_config = {});
+
+}  // namespace rtcl
