@@ -98,6 +98,15 @@ Errors closest_errors(const Geometry& g, const std::vector<Ray>& rays, const std
   return e;
 }
 
+// At most `limit` rays spread over the whole image: an odd stride, so that
+// the picks do not line up in the columns of a power-of-two wide image.
+RaySet scattered_subset(const std::vector<Ray>& rays, std::size_t limit) {
+  std::size_t stride = std::max<std::size_t>(1, (rays.size() + limit - 1) / limit) | 1;
+  RaySet out;
+  for (std::size_t i = 0; i < rays.size(); i += stride) out.rays.push_back(rays[i]);
+  return out;
+}
+
 // One scene's structures per level, its primary rays on the device and the
 // reference of the subset: built at the first benchmark of the scene.
 struct PrecisionScene {
@@ -114,7 +123,7 @@ PrecisionScene& precision_scene(const std::string& name) {
     resident.reset();
     auto p = std::make_unique<PrecisionScene>();
     p->scene = bench_scene(name);
-    p->subset = subset(p->scene->primary, precision_ray_limit());
+    p->subset = scattered_subset(p->scene->primary.rays, precision_ray_limit());
     p->reference = test::reference_closest_all(p->scene->geometry, p->subset.rays);
     const std::vector<Ray>& all = p->scene->primary.rays;
     p->rays = bench_device().upload(all.data(), all.size() * sizeof(Ray), "primary rays");
