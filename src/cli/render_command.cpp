@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "accel_option.hpp"
 #include "commands.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/cl/device.hpp"
@@ -33,11 +34,6 @@ struct Options {
   bool quiet = false;
   bool verbose = false;
 };
-
-std::string default_accel() {
-  auto names = accel_names();
-  return std::find(names.begin(), names.end(), "bvh") != names.end() ? "bvh" : names.front();
-}
 
 // A one-line bar on stderr, redrawn only when the shown percentage changes.
 class ProgressBar {
@@ -87,7 +83,7 @@ void run(const Options& o) {
   settings.batch_pixels = o.batch;
 
   Device device = Device::open(o.device);
-  std::string accel = o.accel.empty() ? default_accel() : o.accel;
+  std::string accel = accel_or_default(o.accel);
   Renderer renderer(device, scene, accel);
   ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
   Image image = renderer.render(settings, [&](double f) { bar.update(f); });
@@ -124,8 +120,7 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
                                             ".exr: linear float)")
       ->capture_default_str();
-  cmd->add_option("--accel", o->accel, "Acceleration structure (default: bvh)")
-      ->check(CLI::IsMember(accel_names()));
+  add_accel_option(*cmd, o->accel);
   cmd->add_option("--device", o->device, "OpenCL device: index or name substring (see `rtcl devices`)");
   cmd->add_option("--width", o->width, "Image width in pixels")->capture_default_str()->check(CLI::Range(1, 65536));
   cmd->add_option("--height", o->height, "Image height in pixels (default: width / the camera's aspect)")

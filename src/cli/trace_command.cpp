@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "accel_option.hpp"
 #include "commands.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/cl/device.hpp"
@@ -32,19 +33,6 @@ using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-std::string joined(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
-// "bvh" when it is registered, else the first structure (brute force).
-std::string default_accel() {
-  std::vector<std::string> names = accel_names();
-  if (std::find(names.begin(), names.end(), "bvh") != names.end()) return "bvh";
-  return names.empty() ? "brute" : names.front();
 }
 
 struct TraceResult {
@@ -77,10 +65,7 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
 }
 
 void run_trace(const TraceOptions& options) {
-  std::string accel_name = options.accel.empty() ? default_accel() : options.accel;
-  std::vector<std::string> names = accel_names();
-  if (std::find(names.begin(), names.end(), accel_name) == names.end())
-    throw Error("--accel " + accel_name + ": unknown acceleration structure (known: " + joined(names) + ")");
+  std::string accel_name = accel_or_default(options.accel);
   check_writable(options.hits);
 
   Clock::time_point load_start = Clock::now();
@@ -141,8 +126,7 @@ void add_trace_command(CLI::App& app) {
   cmd->add_option("-o,--output", options->hits,
                   "hit file to write: 16 bytes per ray, float32 t u v + int32 prim (miss: t=inf, prim=-1)")
       ->required();
-  cmd->add_option("--accel", options->accel,
-                  "acceleration structure: " + joined(accel_names()) + " (default: " + default_accel() + ")");
+  add_accel_option(*cmd, options->accel);
   cmd->add_option("--device", options->device,
                   "OpenCL device: index or name substring from `rtcl devices` (default: $RTCL_DEVICE, else 0)");
   cmd->add_flag("--any", options->any, "occlusion query: report any hit in [tmin, tmax], not the closest");
