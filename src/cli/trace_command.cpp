@@ -86,6 +86,10 @@ void run_trace(const TraceOptions& options) {
   std::printf("rays:   %s: %zu rays\n", options.rays.c_str(), rays.size());
   std::fflush(stdout);
 
+  // A ray set the device cannot hold is refused before anything is uploaded.
+  device.check_fits(rays.size() * sizeof(Ray), "ray buffer for " + options.rays);
+  device.check_fits(rays.size() * sizeof(Hit), "hit buffer for " + options.rays);
+
   Clock::time_point build_start = Clock::now();
   std::unique_ptr<Accel> accel = make_accel(device, accel_name, mesh.geometry);
   double setup_ms = ms_since(build_start);
