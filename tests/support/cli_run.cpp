@@ -1,7 +1,9 @@
 #include "support/cli_run.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -21,16 +23,26 @@ CliRun run_cli(const TempDir& dir, const std::vector<std::string>& args, const s
   if (!std::filesystem::exists(std::string(RTCL_BINARY_DIR) + "/rtcl"))
     return {-2, "",
             std::string("the rtcl binary is missing from ") + RTCL_BINARY_DIR + " (configure with RTCL_BUILD_CLI=ON)"};
-  std::string command = "cd " + shell_quoted(dir.path()) + " && " + limits + " " + env + " " +
+  // timeout: a hang fails the test (exit 124) instead of stalling the suite.
+  std::string command = "cd " + shell_quoted(dir.path()) + " && " + limits + " " + env + " exec timeout 120 " +
                         shell_quoted(std::string(RTCL_BINARY_DIR) + "/rtcl");
   for (const auto& a : args) command += " " + shell_quoted(a);
   // Captured outside dir, so that dir holds only what rtcl wrote.
   std::string out = dir.path() + ".stdout", err = dir.path() + ".stderr";
   command += " >" + shell_quoted(out) + " 2>" + shell_quoted(err);
   auto start = std::chrono::steady_clock::now();
-  int raw = std::system(command.c_str());
   CliRun run;
+  // fork + wait4 rather than std::system: the rusage is this run's alone.
+  pid_t pid = ::fork();
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  int raw = 0;
+  struct rusage usage {};
+  if (pid < 0 || ::wait4(pid, &raw, 0, &usage) != pid) return {-3, "", "cannot start " + command};
   run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  run.max_rss_mib = static_cast<double>(usage.ru_maxrss) / 1024.0;
   run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   run.out = read_text(out);
   run.err = read_text(err);

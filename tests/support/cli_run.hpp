@@ -12,9 +12,12 @@
 namespace rtcl::test {
 
 struct CliRun {
-  int status = -1;  // exit code; -1 when the process did not exit normally (a crash), -2: no binary
+  // exit code; -1 when the process did not exit normally (a crash), -2: no
+  // binary, -3: no process; 124: killed after 120 s (a hang)
+  int status = -1;
   std::string out, err;
-  double seconds = 0.0;  // wall-clock time of the run
+  double seconds = 0.0;      // wall-clock time of the run
+  double max_rss_mib = 0.0;  // peak resident memory of the run (the largest of its processes)
 };
 
 std::string shell_quoted(const std::string& s);
