@@ -140,11 +140,13 @@ std::uint64_t min_instance_bytes(const PlyElement& element, PlyFormat format) {
 }
 
 // Every element count against the body size, before any instance is read.
+// (ASCII: the last value of the file needs no separator, hence one byte more.)
 void check_element_counts(const std::string& path, const PlyHeader& header, std::uint64_t body_bytes) {
   std::uint64_t needed = 0;
+  std::uint64_t available = body_bytes + (header.format == PlyFormat::ascii ? 1 : 0);
   for (const PlyElement& e : header.elements) {
     std::uint64_t per = min_instance_bytes(e, header.format);
-    if (e.count > (body_bytes - std::min(needed, body_bytes)) / per)
+    if (e.count > (available - std::min(needed, available)) / per)
       throw Error(path + ": PLY header declares " + std::to_string(e.count) + " '" + e.name + "' elements of at " +
                   "least " + std::to_string(per) + " bytes each, but only " + std::to_string(body_bytes) +
                   " bytes of data follow the header");
@@ -206,7 +208,7 @@ void walk_ascii_body(const std::string& path, const PlyHeader& header, std::stri
         if (p.count_bytes == 0) continue;
         std::optional<std::uint64_t> length = unsigned_number(*token);
         if (!length) return;  // not a length: Assimp reports the syntax error
-        if (*length > (body.size() - pos) / 2)
+        if (*length > (body.size() - pos + 1) / 2)  // a digit and a separator each, but the last
           too_short(path, e, i,
                     "a list declares " + std::to_string(*length) + " entries, but only " +
                         std::to_string(body.size() - pos) + " bytes remain");
