@@ -1,7 +1,6 @@
 // Runs the built `rtcl` binary as a subprocess, with good and bad inputs in a
 // temporary directory, and checks exit codes, messages and output files.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -13,57 +12,11 @@
 #include "rtcl/scene/mesh_io.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"
+#include "support/cli_run.hpp"
 #include "support/temp_dir.hpp"
 
 namespace rtcl::test {
 namespace {
-
-struct CliRun {
-  int status = -1;  // exit code; -1 when the process did not exit normally (a crash), -2: no binary
-  std::string out, err;
-};
-
-std::string shell_quoted(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-// `env` is prepended as shell assignments ("NAME=value ...", already quoted).
-CliRun run_cli(const TempDir& dir, const std::vector<std::string>& args, const std::string& env = "") {
-  if (!std::filesystem::exists(std::string(RTCL_BINARY_DIR) + "/rtcl"))
-    return {-2, "",
-            std::string("the rtcl binary is missing from ") + RTCL_BINARY_DIR + " (configure with RTCL_BUILD_CLI=ON)"};
-  std::string command =
-      "cd " + shell_quoted(dir.path()) + " && " + env + " " + shell_quoted(std::string(RTCL_BINARY_DIR) + "/rtcl");
-  for (const auto& a : args) command += " " + shell_quoted(a);
-  std::string out = dir.file(".stdout"), err = dir.file(".stderr");
-  command += " >" + shell_quoted(out) + " 2>" + shell_quoted(err);
-  int raw = std::system(command.c_str());
-  CliRun run;
-  run.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  run.out = read_text(out);
-  run.err = read_text(err);
-  std::remove(out.c_str());
-  std::remove(err.c_str());
-  return run;
-}
-
-std::size_t count_of(const std::string& text, const std::string& fragment) {
-  std::size_t n = 0;
-  for (std::size_t p = text.find(fragment); p != std::string::npos; p = text.find(fragment, p + 1)) ++n;
-  return n;
-}
-
-// A failed run: exit 1, exactly one "rtcl: error:" line containing
-// `fragment`, and no hit file left behind (`hits` when given).
-void expect_failure(const CliRun& run, const std::string& fragment, const TempDir& dir, const std::string& hits = "") {
-  EXPECT_EQ(run.status, 1) << run.err;
-  EXPECT_EQ(count_of(run.err, "rtcl: error:"), 1u) << run.err;
-  EXPECT_NE(run.err.find(fragment), std::string::npos) << run.err;
-  if (!hits.empty()) EXPECT_FALSE(std::filesystem::exists(dir.file(hits))) << hits << " was written";
-  for (const auto& name : dir.entries()) EXPECT_EQ(name.find(".tmp-"), std::string::npos) << "left behind: " << name;
-}
 
 // Two triangles forming a unit quad at z = 0 plus a tetrahedron above it.
 const char* const small_obj =
@@ -86,7 +39,7 @@ struct Inputs {
 TEST(Cli, NoArgumentsShowsUsageAndFails) {
   TempDir dir;
   CliRun run = run_cli(dir, {});
-  EXPECT_NE(run.status, 0);
+  EXPECT_EQ(run.status, 2);
   EXPECT_NE(run.err.find("Usage: rtcl"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("trace"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("devices"), std::string::npos) << run.err;
@@ -94,9 +47,42 @@ TEST(Cli, NoArgumentsShowsUsageAndFails) {
 
 TEST(Cli, TraceWithoutOutputIsAUsageError) {
   Inputs in;
-  CliRun run = run_cli(in.dir, {"trace", in.mesh, in.rays});
-  EXPECT_NE(run.status, 0);
-  EXPECT_NE(run.err.find("--output"), std::string::npos) << run.err;
+  expect_usage_error(run_cli(in.dir, {"trace", in.mesh, in.rays}), "--output is required");
+}
+
+// Every bad command line: one "rtcl: error:" line naming the option or
+// argument, a pointer to --help, exit 2 (README, "Robustness"); nothing is
+// written.
+TEST(CliErrors, UsageErrorsAreOneLineAndExit2) {
+  Inputs in;
+  std::vector<std::string> trace = {"trace", in.mesh, in.rays, "-o", "out.hits"};
+  auto with = [](std::vector<std::string> base, std::vector<std::string> extra) {
+    base.insert(base.end(), extra.begin(), extra.end());
+    return base;
+  };
+  expect_usage_error(run_cli(in.dir, {"render", "--width", "0", "-o", "x.png"}), "--width: Value 0 not in range");
+  expect_usage_error(run_cli(in.dir, {"render", "--width", "abc", "-o", "x.png"}), "--width");
+  expect_usage_error(run_cli(in.dir, {"render", "--spp"}), "--spp");
+  expect_usage_error(run_cli(in.dir, {"render", "--accel", "nope", "-o", "x.png"}),
+                     "--accel: unknown acceleration structure 'nope' (known: brute");
+  expect_usage_error(run_cli(in.dir, with(trace, {"--accel", "nope"})),
+                     "--accel: unknown acceleration structure 'nope' (known: brute");
+  expect_usage_error(run_cli(in.dir, with(trace, {"--frobnicate"})), "unknown option '--frobnicate'");
+  expect_usage_error(run_cli(in.dir, {"trace", "--frobnicate"}), "unknown option '--frobnicate'");
+  expect_usage_error(run_cli(in.dir, with(trace, {"extra"})), "unexpected argument 'extra'");
+  expect_usage_error(run_cli(in.dir, {"trace", in.mesh}), "RAYS is required");
+  expect_usage_error(run_cli(in.dir, {"no-such-command"}), "unexpected argument 'no-such-command'");
+  EXPECT_FALSE(std::filesystem::exists(in.dir.file("out.hits")));
+  EXPECT_FALSE(std::filesystem::exists(in.dir.file("x.png")));
+}
+
+TEST(Cli, HelpExits0) {
+  TempDir dir;
+  for (const char* command : {"trace", "render", "devices"}) {
+    CliRun run = run_cli(dir, {command, "--help"});
+    EXPECT_EQ(run.status, 0) << command << ": " << run.err;
+    EXPECT_NE(run.out.find("Usage: rtcl " + std::string(command)), std::string::npos) << run.out;
+  }
 }
 
 TEST(Cli, DevicesListsTheTestDevice) {
@@ -225,8 +211,7 @@ TEST(CliErrors, UnknownAccelAndDevice) {
     args.insert(args.end(), extra.begin(), extra.end());
     return run_cli(in.dir, args);
   };
-  expect_failure(with({"--accel", "octopus"}), "--accel octopus: unknown acceleration structure (known: brute", in.dir,
-                 "out.hits");
+  expect_usage_error(with({"--accel", "octopus"}), "--accel: unknown acceleration structure 'octopus' (known: brute");
   expect_failure(with({"--device", "no-such-device-name"}), "--device 'no-such-device-name': no device name matches",
                  in.dir, "out.hits");
   expect_failure(with({"--device", "99"}), "--device 99: no such device", in.dir, "out.hits");

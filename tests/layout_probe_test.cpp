@@ -1,4 +1,5 @@
-// The device compiler lays out the shared records (kernels/shared/layouts.h)
+// The device compiler lays out the shared records (kernels/shared/layouts.h,
+// kernels/shared/render_layouts.h; the list: kernels/probe/layout_entries.h)
 // exactly as the host compiler does: sizes, strides, field offsets and the
 // shared macros agree, and records written on one side read back field by
 // field on the other (kernels/probe/layout_probe.cl).
@@ -9,6 +10,7 @@
 #include <vector>
 
 #include "rtcl/layouts.hpp"
+#include "rtcl/render/render_layouts.hpp"
 #include "support/fixtures.hpp"
 
 namespace rtcl::test {
@@ -27,56 +29,16 @@ cl_uint offset_of(F field) {
   return static_cast<cl_uint>(reinterpret_cast<const char*>(field(record)) - reinterpret_cast<const char*>(&record));
 }
 
-// Same entries, same order as probe_layout in kernels/probe/layout_probe.cl.
+// The host's values for the entries of kernels/probe/layout_entries.h, the
+// list probe_layout walks on the device.
+#define RTCL_PROBE_RECORD(T) {"sizeof(" #T ")", sizeof(T)}, {#T " array stride", sizeof(T[2]) / 2},
+#define RTCL_PROBE_FIELD(T, member) {#T "." #member, offset_of<T>([](auto& r) { return &r.member; })},
+#define RTCL_PROBE_SIZE(NAME, TYPE) {#NAME " (device: sizeof(" #TYPE "))", NAME},
+#define RTCL_PROBE_VALUE(EXPR) {#EXPR, static_cast<cl_uint>(EXPR)},
 std::vector<Entry> host_layout() {
   return {
-      {"sizeof(Ray)", sizeof(Ray)},
-      {"Ray array stride", sizeof(Ray[2]) / 2},
-      {"Ray.ox", offsetof(Ray, ox)},
-      {"Ray.oy", offsetof(Ray, oy)},
-      {"Ray.oz", offsetof(Ray, oz)},
-      {"Ray.dx", offsetof(Ray, dx)},
-      {"Ray.dy", offsetof(Ray, dy)},
-      {"Ray.dz", offsetof(Ray, dz)},
-      {"Ray.tmin", offsetof(Ray, tmin)},
-      {"Ray.tmax", offsetof(Ray, tmax)},
-      {"sizeof(Hit)", sizeof(Hit)},
-      {"Hit array stride", sizeof(Hit[2]) / 2},
-      {"Hit.t", offsetof(Hit, t)},
-      {"Hit.u", offsetof(Hit, u)},
-      {"Hit.v", offsetof(Hit, v)},
-      {"Hit.prim", offsetof(Hit, prim)},
-      {"sizeof(TriangleBlock)", sizeof(TriangleBlock)},
-      {"TriangleBlock array stride", sizeof(TriangleBlock[2]) / 2},
-      {"TriangleBlock.v", offsetof(TriangleBlock, v)},
-      {"TriangleBlock.v[1][0][0]", offset_of<TriangleBlock>([](auto& r) { return &r.v[1][0][0]; })},
-      {"TriangleBlock.v[0][1][0]", offset_of<TriangleBlock>([](auto& r) { return &r.v[0][1][0]; })},
-      {"TriangleBlock.v[2][2][7]", offset_of<TriangleBlock>([](auto& r) { return &r.v[2][2][7]; })},
-      {"TriangleBlock.prim", offsetof(TriangleBlock, prim)},
-      {"sizeof(SphereBlock)", sizeof(SphereBlock)},
-      {"SphereBlock array stride", sizeof(SphereBlock[2]) / 2},
-      {"SphereBlock.cx", offsetof(SphereBlock, cx)},
-      {"SphereBlock.cy", offsetof(SphereBlock, cy)},
-      {"SphereBlock.cz", offsetof(SphereBlock, cz)},
-      {"SphereBlock.r", offsetof(SphereBlock, r)},
-      {"SphereBlock.prim", offsetof(SphereBlock, prim)},
-      {"sizeof(Bvh8Node)", sizeof(Bvh8Node)},
-      {"Bvh8Node array stride", sizeof(Bvh8Node[2]) / 2},
-      {"Bvh8Node.bounds", offsetof(Bvh8Node, bounds)},
-      {"Bvh8Node.bounds[3][0]", offset_of<Bvh8Node>([](auto& r) { return &r.bounds[3][0]; })},
-      {"Bvh8Node.bounds[5][7]", offset_of<Bvh8Node>([](auto& r) { return &r.bounds[5][7]; })},
-      {"Bvh8Node.child", offsetof(Bvh8Node, child)},
-      {"RTCL_BLOCK_WIDTH", RTCL_BLOCK_WIDTH},
-      {"RTCL_CHILD_EMPTY", static_cast<cl_uint>(RTCL_CHILD_EMPTY)},
-      {"RTCL_LEAF_TRIANGLES(5)", static_cast<cl_uint>(RTCL_LEAF_TRIANGLES(5))},
-      {"RTCL_LEAF_SPHERES(5)", static_cast<cl_uint>(RTCL_LEAF_SPHERES(5))},
+#include "probe/layout_entries.h"
   };
-}
-
-template <class T>
-cl::Buffer two_records(const Device& device, const T& record, const char* what) {
-  T pair[2] = {record, record};
-  return device.upload(pair, sizeof pair, what);
 }
 
 TEST(LayoutProbe, DeviceSizesAndOffsetsMatchHost) {
@@ -85,19 +47,9 @@ TEST(LayoutProbe, DeviceSizesAndOffsetsMatchHost) {
   std::vector<Entry> host = host_layout();
   std::vector<cl_uint> out(host.size() + 16, 0xdeadbeefu);
   with_cl_errors([&] {
-    cl::Buffer rays = two_records(device, Ray{}, "probe rays");
-    cl::Buffer hits = two_records(device, Hit{}, "probe hits");
-    cl::Buffer tris = two_records(device, TriangleBlock{}, "probe triangle blocks");
-    cl::Buffer spheres = two_records(device, SphereBlock{}, "probe sphere blocks");
-    cl::Buffer nodes = two_records(device, Bvh8Node{}, "probe nodes");
     cl::Buffer result = device.allocate(out.size() * sizeof(cl_uint), "probe layout");
     cl::Kernel kernel(program, "probe_layout");
-    kernel.setArg(0, rays);
-    kernel.setArg(1, hits);
-    kernel.setArg(2, tris);
-    kernel.setArg(3, spheres);
-    kernel.setArg(4, nodes);
-    kernel.setArg(5, result);
+    kernel.setArg(0, result);
     device.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(1));
     device.queue().enqueueReadBuffer(result, CL_TRUE, 0, out.size() * sizeof(cl_uint), out.data());
   });

@@ -332,10 +332,16 @@ TEST(MeshIoErrors, MissingFileDirectoryAndExtension) {
 
 TEST(MeshIoErrors, AssimpParseFailuresCarryAssimpsMessage) {
   TempDir dir;
-  expect_error(dir.write("empty.obj", ""), "cannot import mesh: OBJ-file is too small");
   expect_error(dir.write("letters.obj", std::string(triangle_v) + "f 1 2 x\n"), "Invalid face index");
-  expect_error(dir.write("junk.ply", "this is not a ply file at all\n"), "cannot import mesh");
-  expect_error(dir.write("empty.stl", ""), "cannot import mesh");
+  expect_error(dir.write("tiny.obj", "v"), "cannot import mesh: OBJ-file is too small");
+  expect_error(dir.write("broken.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\n"), "cannot import mesh");
+}
+
+// Checked before Assimp reads the file (scene/mesh_precheck.hpp).
+TEST(MeshIoErrors, EmptyFilesAndNonPlyHeaders) {
+  TempDir dir;
+  for (const char* name : {"empty.obj", "empty.ply", "empty.stl"}) expect_error(dir.write(name, ""), "the file is empty");
+  expect_error(dir.write("junk.ply", "this is not a ply file at all\n"), "not a PLY file (the first line is not 'ply')");
 }
 
 TEST(MeshIoErrors, OutOfRangeIndices) {

@@ -1,61 +1,33 @@
-/* The device compiler's view of the shared records (kernels/shared/layouts.h),
- * for tests/layout_probe_test.cpp, which compares it with the host's.
- * probe_layout writes sizes, array strides and field offsets in bytes;
+/* The device compiler's view of the shared records (kernels/shared/layouts.h,
+ * kernels/shared/render_layouts.h), for tests/layout_probe_test.cpp, which
+ * compares it with the host's. probe_layout writes, for every entry of
+ * probe/layout_entries.h in order, the size, stride, offset or value;
  * probe_fields reads host-written records field by field and writes one
  * Hit field by field, proving that both sides address the same bytes. */
 #include "shared/layouts.h"
+#include "shared/render_layouts.h"
 
-/* Byte offset of a field inside the record `rec` points to. OpenCL C 1.2 has
- * no offsetof; the difference of two pointers into one object is portable. */
-#define PROBE_OFFSET(rec, field) \
-  ((uint)((global const char*)&(rec)->field - (global const char*)(rec)))
-#define PROBE_STRIDE(rec) ((uint)((global const char*)((rec) + 1) - (global const char*)(rec)))
+/* Byte offsets inside a private record: layout does not depend on the
+ * address space, and OpenCL C 1.2 has no offsetof; the difference of two
+ * pointers into one object is portable. */
+#define RTCL_PROBE_RECORD(T)             \
+  {                                      \
+    T pair[2];                           \
+    out[k++] = (uint)sizeof(T);          \
+    out[k++] = (uint)((private char*)&pair[1] - (private char*)&pair[0]); \
+  }
+#define RTCL_PROBE_FIELD(T, member) \
+  {                                 \
+    T record;                       \
+    out[k++] = (uint)((private char*)&record.member - (private char*)&record); \
+  }
+#define RTCL_PROBE_SIZE(NAME, TYPE) out[k++] = (uint)sizeof(TYPE);
+#define RTCL_PROBE_VALUE(EXPR) out[k++] = (uint)(EXPR);
 
-/* out[0] = number of entries that follow; then, in this order (the host test
- * lists the same entries in the same order): */
-kernel void probe_layout(global const Ray* ray, global const Hit* hit, global const TriangleBlock* tri,
-                         global const SphereBlock* sph, global const Bvh8Node* node, global uint* out) {
+/* out[0] = number of entries that follow. */
+kernel void probe_layout(global uint* out) {
   uint k = 1;
-  out[k++] = sizeof(Ray);
-  out[k++] = PROBE_STRIDE(ray);
-  out[k++] = PROBE_OFFSET(ray, ox);
-  out[k++] = PROBE_OFFSET(ray, oy);
-  out[k++] = PROBE_OFFSET(ray, oz);
-  out[k++] = PROBE_OFFSET(ray, dx);
-  out[k++] = PROBE_OFFSET(ray, dy);
-  out[k++] = PROBE_OFFSET(ray, dz);
-  out[k++] = PROBE_OFFSET(ray, tmin);
-  out[k++] = PROBE_OFFSET(ray, tmax);
-  out[k++] = sizeof(Hit);
-  out[k++] = PROBE_STRIDE(hit);
-  out[k++] = PROBE_OFFSET(hit, t);
-  out[k++] = PROBE_OFFSET(hit, u);
-  out[k++] = PROBE_OFFSET(hit, v);
-  out[k++] = PROBE_OFFSET(hit, prim);
-  out[k++] = sizeof(TriangleBlock);
-  out[k++] = PROBE_STRIDE(tri);
-  out[k++] = PROBE_OFFSET(tri, v);
-  out[k++] = PROBE_OFFSET(tri, v[1][0][0]);
-  out[k++] = PROBE_OFFSET(tri, v[0][1][0]);
-  out[k++] = PROBE_OFFSET(tri, v[2][2][7]);
-  out[k++] = PROBE_OFFSET(tri, prim);
-  out[k++] = sizeof(SphereBlock);
-  out[k++] = PROBE_STRIDE(sph);
-  out[k++] = PROBE_OFFSET(sph, cx);
-  out[k++] = PROBE_OFFSET(sph, cy);
-  out[k++] = PROBE_OFFSET(sph, cz);
-  out[k++] = PROBE_OFFSET(sph, r);
-  out[k++] = PROBE_OFFSET(sph, prim);
-  out[k++] = sizeof(Bvh8Node);
-  out[k++] = PROBE_STRIDE(node);
-  out[k++] = PROBE_OFFSET(node, bounds);
-  out[k++] = PROBE_OFFSET(node, bounds[3][0]);
-  out[k++] = PROBE_OFFSET(node, bounds[5][7]);
-  out[k++] = PROBE_OFFSET(node, child);
-  out[k++] = RTCL_BLOCK_WIDTH;
-  out[k++] = (uint)RTCL_CHILD_EMPTY;
-  out[k++] = (uint)RTCL_LEAF_TRIANGLES(5);
-  out[k++] = (uint)RTCL_LEAF_SPHERES(5);
+#include "probe/layout_entries.h"
   out[0] = k - 1;
 }
 

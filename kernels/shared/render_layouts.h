@@ -70,6 +70,18 @@ typedef struct ShadeSphere {
   rtcl_u32 material;
 } ShadeSphere;
 
+/* Entry sizes of the buffers the kernels address as vectors or plain
+ * words rather than as records (tests/layout_probe_test.cpp checks each
+ * against the device compiler's sizeof):
+ * - RTCL_RADIANCE_BYTES: one float4 of linear RGB + an unused lane, per entry
+ *   of the path radiance, shadow-slot weight and framebuffer buffers;
+ * - RTCL_CHUNK_COUNT_BYTES: one uint pair per compaction chunk c,
+ *   counts[2c] (flagged slots) and counts[2c + 1] (refracted ones);
+ * - RTCL_FLAG_BYTES: one uint per slot flag or slot index. */
+#define RTCL_RADIANCE_BYTES 16u
+#define RTCL_CHUNK_COUNT_BYTES 8u
+#define RTCL_FLAG_BYTES 4u
+
 /* Slot flags written by the shade kernel and read by the compaction: 0 = no
  * ray, else the kind of ray (counted separately). */
 #define RTCL_SLOT_EMPTY 0u

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "accel_option.hpp"
 #include "commands.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/cl/device.hpp"
@@ -34,11 +35,6 @@ struct Options {
   bool quiet = false;
   bool verbose = false;
 };
-
-std::string default_accel() {
-  auto names = accel_names();
-  return std::find(names.begin(), names.end(), "bvh") != names.end() ? "bvh" : names.front();
-}
 
 // A one-line bar on stderr, redrawn only when the shown percentage changes.
 class ProgressBar {
@@ -129,9 +125,7 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
                                             ".exr: linear float)")
       ->capture_default_str();
-  cmd->add_option("--accel", o->accel,
-                  "Acceleration structure, optionally with build options: NAME or NAME:key=value,... (default: "
-                  "the scene's \"accel\", else bvh; `rtcl structures` lists them)");
+  add_accel_option(*cmd, o->accel);
   cmd->add_option("--precision", o->precision,
                   "fast | robust | exact: the trace kernels' precision level and the spawn offsets (default: the "
                   "scene file's \"precision\", else robust; see README, Precision levels)");

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "accel_option.hpp"
 #include "commands.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/cl/device.hpp"
@@ -33,19 +34,6 @@ using Clock = std::chrono::steady_clock;
 
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-std::string joined(const std::vector<std::string>& names) {
-  std::string out;
-  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
-  return out;
-}
-
-// "bvh" when it is registered, else the first structure (brute force).
-std::string default_accel() {
-  std::vector<std::string> names = accel_names();
-  if (std::find(names.begin(), names.end(), "bvh") != names.end()) return "bvh";
-  return names.empty() ? "brute" : names.front();
 }
 
 struct TraceResult {
@@ -78,7 +66,7 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
 }
 
 void run_trace(const TraceOptions& options) {
-  std::string accel_name = options.accel.empty() ? default_accel() : options.accel;
+  std::string accel_name = accel_or_default(options.accel);
   parse_accel_spec(accel_name);  // name and options checked before any work
   AccelConfig config;
   config.precision = parse_precision(options.precision);
@@ -102,6 +90,10 @@ void run_trace(const TraceOptions& options) {
               mesh.geometry.triangles.size(), mesh.geometry.vertices.size(), mesh.objects.size(), load_ms);
   std::printf("rays:   %s: %zu rays\n", options.rays.c_str(), rays.size());
   std::fflush(stdout);
+
+  // A ray set the device cannot hold is refused before anything is uploaded.
+  device.check_fits(rays.size() * sizeof(Ray), "ray buffer for " + options.rays);
+  device.check_fits(rays.size() * sizeof(Hit), "hit buffer for " + options.rays);
 
   Clock::time_point build_start = Clock::now();
   std::unique_ptr<Accel> accel = make_accel(device, accel_name, mesh.geometry, config);
@@ -144,10 +136,7 @@ void add_trace_command(CLI::App& app) {
   cmd->add_option("-o,--output", options->hits,
                   "hit file to write: 16 bytes per ray, float32 t u v + int32 prim (miss: t=inf, prim=-1)")
       ->required();
-  cmd->add_option("--accel", options->accel,
-                  "acceleration structure: " + joined(accel_names()) + " (default: " + default_accel() +
-                      "), with build options as NAME:key=value,... e.g. grid:lambda=4 or grid:res=64x32x16 "
-                      "(`rtcl structures` lists every option and default)");
+  add_accel_option(*cmd, options->accel);
   cmd->add_option("--precision", options->precision,
                   "fast | robust | exact: Moller-Trumbore and fast math / watertight (default) / watertight plus "
                   "double-precision re-tests (see README, Precision levels)")

@@ -64,9 +64,26 @@ const char* cl_error_name(int status) {
   }
 }
 
+const char* cl_error_hint(int status) {
+  switch (status) {
+    case CL_MEM_OBJECT_ALLOCATION_FAILURE:
+    case CL_OUT_OF_RESOURCES:
+    case CL_OUT_OF_HOST_MEMORY:
+      return "; the device ran out of memory: try a smaller scene or ray set, a smaller --batch, or another "
+             "device (rtcl devices)";
+    default:
+      return "";
+  }
+}
+
 void check_cl(int status, const char* call) {
-  if (status != CL_SUCCESS)
-    throw Error(std::string(call) + " failed: " + cl_error_name(status) + " (" + std::to_string(status) + ")");
+  if (status == CL_SUCCESS) return;
+  std::string message = call;
+  message += " failed: ";
+  message += cl_error_name(status);
+  message += " (" + std::to_string(status) + ")";
+  message += cl_error_hint(status);
+  throw Error(message);
 }
 
 }  // namespace rtcl

@@ -1,6 +1,7 @@
 #include "rtcl/cl/device.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cstdlib>
 #include <functional>
@@ -8,6 +9,7 @@
 #include <mutex>
 #include <tuple>
 
+#include "rtcl/cl/device_limits.hpp"
 #include "rtcl/cl/program.hpp"
 #include "rtcl/error.hpp"
 
@@ -22,6 +24,10 @@ struct Device::State {
   mutable std::mutex cache_mutex;
   // key: source hash, options
   mutable std::map<std::tuple<std::size_t, std::string>, cl::Program> programs;
+  // Bytes of the buffers allocated through this device that are still alive
+  // (decremented by each buffer's OpenCL destructor callback, which may run
+  // after the Device is gone, hence shared).
+  std::shared_ptr<std::atomic<std::size_t>> live_bytes = std::make_shared<std::atomic<std::size_t>>(0);
 };
 
 namespace {
@@ -48,8 +54,10 @@ DeviceInfo describe(const cl::Platform& platform, const cl::Device& device, std:
                                                     : "other";
   info.version = trim(device.getInfo<CL_DEVICE_VERSION>());
   info.compute_units = device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
-  info.global_mem_bytes = device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
-  info.max_alloc_bytes = device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  DeviceLimits limits = limits_with_overrides(
+      {device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>(), device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>()});
+  info.global_mem_bytes = limits.global_mem_bytes;
+  info.max_alloc_bytes = limits.max_alloc_bytes;
   info.fp64 = device.getInfo<CL_DEVICE_EXTENSIONS>().find("cl_khr_fp64") != std::string::npos;
   return info;
 }
@@ -173,11 +181,39 @@ cl::Program Device::program(const std::string& kernel_file, const std::vector<st
   });
 }
 
+namespace {
+
+struct Release {
+  std::shared_ptr<std::atomic<std::size_t>> live_bytes;
+  std::size_t bytes;
+};
+
+void CL_CALLBACK released(cl_mem, void* user_data) {
+  auto* release = static_cast<Release*>(user_data);
+  release->live_bytes->fetch_sub(release->bytes);
+  delete release;
+}
+
+}  // namespace
+
+void Device::check_fits(std::size_t bytes, const std::string& what) const {
+  check_allocation({state_->info.max_alloc_bytes, state_->info.global_mem_bytes}, bytes, *state_->live_bytes, what,
+                   state_->info.name);
+}
+
 cl::Buffer Device::allocate(std::size_t bytes, const char* what, cl_mem_flags flags) const {
-  if (bytes > state_->info.max_alloc_bytes)
-    throw Error(std::string(what) + ": " + std::to_string(bytes) + " bytes exceed the largest buffer " +
-                state_->info.name + " allows (" + std::to_string(state_->info.max_alloc_bytes) + " bytes)");
-  return with_cl_errors([&] { return cl::Buffer(state_->context, flags, std::max<std::size_t>(bytes, 1)); });
+  check_fits(bytes, what);
+  std::size_t charged = std::max<std::size_t>(bytes, 1);
+  return with_cl_errors([&] {
+    cl::Buffer buffer(state_->context, flags, charged);
+    auto* release = new Release{state_->live_bytes, charged};
+    state_->live_bytes->fetch_add(charged);
+    if (::clSetMemObjectDestructorCallback(buffer(), released, release) != CL_SUCCESS) {
+      state_->live_bytes->fetch_sub(charged);  // not tracked: counted as free
+      delete release;
+    }
+    return buffer;
+  });
 }
 
 cl::Buffer Device::upload(const void* data, std::size_t bytes, const char* what) const {

@@ -19,8 +19,10 @@ struct DeviceInfo {
   std::string type;     // "cpu", "gpu", "accelerator", "other"
   std::string version;  // CL_DEVICE_VERSION
   unsigned compute_units = 0;
+  // CL_DEVICE_GLOBAL_MEM_SIZE and CL_DEVICE_MAX_MEM_ALLOC_SIZE (largest
+  // buffer), each lowered by its environment variable (cl/device_limits.hpp)
   std::size_t global_mem_bytes = 0;
-  std::size_t max_alloc_bytes = 0;  // CL_DEVICE_MAX_MEM_ALLOC_SIZE: largest buffer
+  std::size_t max_alloc_bytes = 0;
   bool fp64 = false;
 };
 
@@ -53,8 +55,16 @@ class Device {
   // device + source hash + options; a build failure throws Error with the log.
   cl::Program program(const std::string& kernel_file, const std::vector<std::string>& defines) const;
 
-  // A device buffer holding a copy of host data; Error names `what` when it
-  // exceeds the device's largest allocation.
+  // Throws Error naming `what`, the device and both numbers when `bytes`
+  // exceed the largest buffer the device allows, or when they do not fit in
+  // its global memory beside the buffers already allocated through this
+  // Device (limits: DeviceInfo, lowered by RTCL_MAX_ALLOC_BYTES and
+  // RTCL_MAX_GLOBAL_BYTES, see cl/device_limits.hpp). For callers that
+  // refuse a whole job before its first upload.
+  void check_fits(std::size_t bytes, const std::string& what) const;
+
+  // A device buffer holding a copy of host data; allocate and upload check
+  // it first (check_fits), so a refused buffer is never created.
   cl::Buffer upload(const void* data, std::size_t bytes, const char* what) const;
   cl::Buffer allocate(std::size_t bytes, const char* what, cl_mem_flags flags = CL_MEM_READ_WRITE) const;
 

@@ -27,7 +27,7 @@ decltype(auto) with_cl_errors(F&& f) {
     return std::forward<F>(f)();
   } catch (const cl::Error& e) {
     throw Error(std::string(e.what()) + " failed: " + cl_error_name(e.err()) + " (" +
-                std::to_string(e.err()) + ")");
+                std::to_string(e.err()) + ")" + cl_error_hint(e.err()));
   }
 }
 

@@ -1,7 +1,16 @@
 // Output files are written whole or not at all: the data goes to a temporary
 // file beside the target (same directory, so the final rename(2) is atomic on
-// POSIX file systems), is flushed to disk, and only then replaces the target.
-// On any failure the temporary file is removed and the target is untouched.
+// POSIX file systems), is flushed to disk, and only then replaces the target;
+// the directory is flushed after the rename. On any failure the temporary
+// file is removed and the target is untouched.
+// - A target that is a symbolic link: the file it points to is replaced, the
+//   link stays.
+// - An existing target keeps its permission bits; a new one gets 0666 less
+//   the umask.
+// - Temporary files are hidden, named ".STEM.tmp-PID-RANDOM.EXT" (unique per
+//   process and call), removed if the process is stopped by SIGINT, SIGTERM,
+//   SIGHUP or SIGQUIT (temp_cleanup.hpp); one left by a process killed
+//   outright (SIGKILL) is removed by the next write to the same target.
 #pragma once
 
 #include <cstddef>

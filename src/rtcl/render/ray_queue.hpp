@@ -36,7 +36,7 @@ class GrowingBuffer {
 // 2i + 1 refraction), flag = RTCL_SLOT_* kind.
 struct SpawnSlots {
   GrowingBuffer rays{"spawn slot rays", sizeof(Ray)}, paths{"spawn slot paths", sizeof(PathState)},
-      flags{"spawn slot flags", 4};
+      flags{"spawn slot flags", RTCL_FLAG_BYTES};
   std::size_t count = 0;
   void reserve(const Device& device, std::size_t slots);
 };
@@ -44,8 +44,8 @@ struct SpawnSlots {
 // Slots for shadow rays: light_count per shaded ray, with the contribution
 // each adds when unoccluded and, after compaction, its shadow-queue index.
 struct ShadowSlots {
-  GrowingBuffer rays{"shadow slot rays", sizeof(Ray)}, weights{"shadow slot weights", 16}, flags{"shadow slot flags", 4},
-      index{"shadow slot index", 4};
+  GrowingBuffer rays{"shadow slot rays", sizeof(Ray)}, weights{"shadow slot weights", RTCL_RADIANCE_BYTES},
+      flags{"shadow slot flags", RTCL_FLAG_BYTES}, index{"shadow slot index", RTCL_FLAG_BYTES};
   std::size_t count = 0;
   void reserve(const Device& device, std::size_t slots);
 };
@@ -84,7 +84,7 @@ class RayQueue {
 
  private:
   Device device_;
-  GrowingBuffer rays_{"ray queue", sizeof(Ray)}, paths_{"path states", sizeof(PathState)}, chunk_counts_{"compaction counts", 8};
+  GrowingBuffer rays_{"ray queue", sizeof(Ray)}, paths_{"path states", sizeof(PathState)}, chunk_counts_{"compaction counts", RTCL_CHUNK_COUNT_BYTES};
   std::size_t size_ = 0;
   cl::Kernel generate_, count_, scan_, scatter_;
 };
@@ -106,7 +106,7 @@ class ShadowQueue {
 
  private:
   Device device_;
-  GrowingBuffer rays_{"shadow queue", sizeof(Ray)}, hits_{"shadow hits", sizeof(Hit)}, chunk_counts_{"compaction counts", 8};
+  GrowingBuffer rays_{"shadow queue", sizeof(Ray)}, hits_{"shadow hits", sizeof(Hit)}, chunk_counts_{"compaction counts", RTCL_CHUNK_COUNT_BYTES};
   std::size_t size_ = 0;
   cl::Kernel count_, scan_, scatter_;
 };

@@ -17,4 +17,7 @@ static_assert(sizeof(ShadeParams) == 40 && offsetof(ShadeParams, min_weight) == 
 static_assert(sizeof(ShadeTriangle) == 40 && offsetof(ShadeTriangle, material) == 36);
 static_assert(sizeof(ShadeSphere) == 20 && offsetof(ShadeSphere, radius) == 12 && offsetof(ShadeSphere, material) == 16);
 
+static_assert(RTCL_RADIANCE_BYTES == 4 * sizeof(float) && RTCL_CHUNK_COUNT_BYTES == 2 * sizeof(rtcl_u32) &&
+              RTCL_FLAG_BYTES == sizeof(rtcl_u32));
+
 }  // namespace rtcl

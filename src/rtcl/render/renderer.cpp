@@ -56,7 +56,7 @@ struct Renderer::State {
   cl::Buffer camera, params, framebuffer, totals;
   // Per generation: queue -> hits -> radiance + slots -> next queue + shadow queue.
   RayQueue queue, next;
-  GrowingBuffer hits{"hits", sizeof(Hit)}, radiance{"path radiance", 16};
+  GrowingBuffer hits{"hits", sizeof(Hit)}, radiance{"path radiance", RTCL_RADIANCE_BYTES};
   SpawnSlots spawn;
   ShadowSlots shadow_slots;
   ShadowQueue shadows;
@@ -112,10 +112,10 @@ void Renderer::prepare(const RenderSettings& settings) {
   params.triangle_count = s.shading.triangle_count;
   s.camera = s.device.upload(&camera, sizeof camera, "camera");
   s.params = s.device.upload(&params, sizeof params, "shading parameters");
-  s.framebuffer = s.device.allocate(std::size_t(pixels) * 16, "framebuffer");
+  s.framebuffer = s.device.allocate(std::size_t(pixels) * RTCL_RADIANCE_BYTES, "framebuffer");
   with_cl_errors([&] {
     cl::Event cleared;
-    s.device.queue().enqueueFillBuffer(s.framebuffer, cl_float4{}, 0, std::size_t(pixels) * 16, nullptr, &cleared);
+    s.device.queue().enqueueFillBuffer(s.framebuffer, cl_float4{}, 0, std::size_t(pixels) * RTCL_RADIANCE_BYTES, nullptr, &cleared);
     s.last = {cleared};
   });
 }
@@ -145,9 +145,10 @@ Image Renderer::render(const RenderSettings& settings, const RenderProgress& pro
       collect_times();
     }
 
+  static_assert(sizeof(cl_float4) == RTCL_RADIANCE_BYTES);
   std::vector<cl_float4> sums(pixels);
   with_cl_errors([&] {
-    s.device.queue().enqueueReadBuffer(s.framebuffer, CL_TRUE, 0, sums.size() * 16, sums.data(), wait_list(s.last));
+    s.device.queue().enqueueReadBuffer(s.framebuffer, CL_TRUE, 0, sums.size() * RTCL_RADIANCE_BYTES, sums.data(), wait_list(s.last));
   });
   Image image;
   image.width = settings.width;

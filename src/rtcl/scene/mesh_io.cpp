@@ -22,6 +22,7 @@
 #include <assimp/scene.h>
 
 #include "rtcl/error.hpp"
+#include "rtcl/scene/mesh_precheck.hpp"
 
 namespace rtcl {
 
@@ -49,6 +50,23 @@ void check_input_file(const std::string& path) {
                 "' (rtcl reads .obj with .mtl, .ply and .stl)");
   std::ifstream probe(path, std::ios::binary);
   if (!probe) throw Error(path + ": cannot read: " + std::strerror(errno));
+}
+
+// The whole file, or its first `limit` bytes.
+std::string read_file(const std::string& path, std::size_t limit = std::numeric_limits<std::size_t>::max()) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::size_t size = static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0));
+  std::string text(std::min(size, limit), '\0');
+  in.seekg(0);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  return text;
+}
+
+// OBJ declares no sizes: only its first byte is read (is it empty?).
+void check_sizes(const std::string& path) {
+  std::string ext = lower_extension(path);
+  check_declared_sizes(path, ext, ext == ".obj" ? read_file(path, 1) : read_file(path));
 }
 
 glm::vec3 color(const aiMaterial& m, const char* key, unsigned type, unsigned index, glm::vec3 fallback) {
@@ -173,11 +191,7 @@ class MeshBuilder {
 // Notes on the two places where Assimp 5.2's OBJ importer departs from the
 // file (see mesh_io.hpp), found by a scan of the statement keywords.
 std::vector<std::string> obj_notes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  std::string text(static_cast<std::size_t>(std::max<std::streamoff>(in.tellg(), 0)), '\0');
-  in.seekg(0);
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
-  text.resize(static_cast<std::size_t>(in.gcount()));
+  std::string text = read_file(path);
   std::vector<std::string> notes;
   std::unordered_set<std::string> names;  // o and g names seen so far
   std::string current_object, repeated;
@@ -227,6 +241,7 @@ std::vector<std::string> obj_notes(const std::string& path) {
 
 LoadedMesh load_mesh(const std::string& path) {
   check_input_file(path);
+  check_sizes(path);
   Assimp::Importer importer;
   const aiScene* scene = nullptr;
   try {

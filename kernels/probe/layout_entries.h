@@ -1,0 +1,84 @@
+/* Every record, field and size convention that crosses the host/device
+ * boundary (kernels/shared/layouts.h, kernels/shared/render_layouts.h), in
+ * one list read by both kernels/probe/layout_probe.cl and
+ * tests/layout_probe_test.cpp, which define the three entry kinds:
+ *   RTCL_PROBE_RECORD(T)          sizeof(T) and the stride of a T array
+ *   RTCL_PROBE_FIELD(T, member)   byte offset of a member designator
+ *   RTCL_PROBE_SIZE(NAME, TYPE)   a host size constant NAME against the
+ *                                 device's sizeof(TYPE)
+ *   RTCL_PROBE_VALUE(EXPR)        a shared constant or macro result
+ * A record added to a shared header is added here, or it is not proved. */
+
+RTCL_PROBE_RECORD(Ray)
+RTCL_PROBE_FIELD(Ray, ox) RTCL_PROBE_FIELD(Ray, oy) RTCL_PROBE_FIELD(Ray, oz)
+RTCL_PROBE_FIELD(Ray, dx) RTCL_PROBE_FIELD(Ray, dy) RTCL_PROBE_FIELD(Ray, dz)
+RTCL_PROBE_FIELD(Ray, tmin) RTCL_PROBE_FIELD(Ray, tmax)
+
+RTCL_PROBE_RECORD(Hit)
+RTCL_PROBE_FIELD(Hit, t) RTCL_PROBE_FIELD(Hit, u) RTCL_PROBE_FIELD(Hit, v) RTCL_PROBE_FIELD(Hit, prim)
+
+RTCL_PROBE_RECORD(TriangleBlock)
+RTCL_PROBE_FIELD(TriangleBlock, v) RTCL_PROBE_FIELD(TriangleBlock, v[1][0][0])
+RTCL_PROBE_FIELD(TriangleBlock, v[0][1][0]) RTCL_PROBE_FIELD(TriangleBlock, v[2][2][7])
+RTCL_PROBE_FIELD(TriangleBlock, prim)
+
+RTCL_PROBE_RECORD(SphereBlock)
+RTCL_PROBE_FIELD(SphereBlock, cx) RTCL_PROBE_FIELD(SphereBlock, cy) RTCL_PROBE_FIELD(SphereBlock, cz)
+RTCL_PROBE_FIELD(SphereBlock, r) RTCL_PROBE_FIELD(SphereBlock, prim)
+
+RTCL_PROBE_RECORD(Bvh8Node)
+RTCL_PROBE_FIELD(Bvh8Node, bounds) RTCL_PROBE_FIELD(Bvh8Node, bounds[3][0])
+RTCL_PROBE_FIELD(Bvh8Node, bounds[5][7]) RTCL_PROBE_FIELD(Bvh8Node, child)
+
+RTCL_PROBE_RECORD(GridHeader)
+RTCL_PROBE_FIELD(GridHeader, lower) RTCL_PROBE_FIELD(GridHeader, cell) RTCL_PROBE_FIELD(GridHeader, res)
+RTCL_PROBE_FIELD(GridHeader, res[2])
+
+RTCL_PROBE_VALUE(RTCL_BLOCK_WIDTH)
+RTCL_PROBE_VALUE(RTCL_CHILD_EMPTY)
+RTCL_PROBE_VALUE(RTCL_LEAF_TRIANGLES(5))
+RTCL_PROBE_VALUE(RTCL_LEAF_SPHERES(5))
+
+RTCL_PROBE_RECORD(PathState)
+RTCL_PROBE_FIELD(PathState, pixel) RTCL_PROBE_FIELD(PathState, depth)
+RTCL_PROBE_FIELD(PathState, wr) RTCL_PROBE_FIELD(PathState, wg) RTCL_PROBE_FIELD(PathState, wb)
+
+RTCL_PROBE_RECORD(DeviceMaterial)
+RTCL_PROBE_FIELD(DeviceMaterial, ambient) RTCL_PROBE_FIELD(DeviceMaterial, diffuse)
+RTCL_PROBE_FIELD(DeviceMaterial, specular) RTCL_PROBE_FIELD(DeviceMaterial, emission)
+RTCL_PROBE_FIELD(DeviceMaterial, kr) RTCL_PROBE_FIELD(DeviceMaterial, kt)
+RTCL_PROBE_FIELD(DeviceMaterial, kt[2]) RTCL_PROBE_FIELD(DeviceMaterial, shininess)
+RTCL_PROBE_FIELD(DeviceMaterial, ior)
+
+RTCL_PROBE_RECORD(DeviceLight)
+RTCL_PROBE_FIELD(DeviceLight, position) RTCL_PROBE_FIELD(DeviceLight, radiance)
+
+RTCL_PROBE_RECORD(DeviceCamera)
+RTCL_PROBE_FIELD(DeviceCamera, origin) RTCL_PROBE_FIELD(DeviceCamera, corner)
+RTCL_PROBE_FIELD(DeviceCamera, du) RTCL_PROBE_FIELD(DeviceCamera, dv)
+RTCL_PROBE_FIELD(DeviceCamera, width) RTCL_PROBE_FIELD(DeviceCamera, height)
+
+RTCL_PROBE_RECORD(ShadeParams)
+RTCL_PROBE_FIELD(ShadeParams, ambient) RTCL_PROBE_FIELD(ShadeParams, background)
+RTCL_PROBE_FIELD(ShadeParams, min_weight) RTCL_PROBE_FIELD(ShadeParams, max_depth)
+RTCL_PROBE_FIELD(ShadeParams, triangle_count) RTCL_PROBE_FIELD(ShadeParams, pad)
+
+RTCL_PROBE_RECORD(ShadeTriangle)
+RTCL_PROBE_FIELD(ShadeTriangle, v) RTCL_PROBE_FIELD(ShadeTriangle, v[2][1])
+RTCL_PROBE_FIELD(ShadeTriangle, material)
+
+RTCL_PROBE_RECORD(ShadeSphere)
+RTCL_PROBE_FIELD(ShadeSphere, center) RTCL_PROBE_FIELD(ShadeSphere, radius)
+RTCL_PROBE_FIELD(ShadeSphere, material)
+
+RTCL_PROBE_SIZE(RTCL_RADIANCE_BYTES, float4)
+RTCL_PROBE_SIZE(RTCL_CHUNK_COUNT_BYTES, uint2)
+RTCL_PROBE_SIZE(RTCL_FLAG_BYTES, uint)
+RTCL_PROBE_VALUE(RTCL_SLOT_EMPTY)
+RTCL_PROBE_VALUE(RTCL_SLOT_SHADOW)
+RTCL_PROBE_VALUE(RTCL_SLOT_REFLECTION)
+RTCL_PROBE_VALUE(RTCL_SLOT_REFRACTION)
+RTCL_PROBE_VALUE(RTCL_SCAN_CHUNK)
+RTCL_PROBE_VALUE(RTCL_TILE)
+RTCL_PROBE_VALUE(rtcl_tile_order_pixel(77u, 13u, 11u))
+RTCL_PROBE_VALUE(rtcl_hash(12345u))

@@ -1,0 +1,25 @@
+// Size checks of mesh files before Assimp reads them. Assimp allocates what a
+// file header declares (PLY element counts and list lengths, the triangle
+// count of a binary STL) before it reads the data, so a 100-byte file that
+// declares 2^31 vertices would cost gigabytes. These checks hold every
+// declared count against the bytes that are actually there.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace rtcl {
+
+// Throws Error naming `path`, the declared size and the available bytes when
+// `bytes` (the whole file) cannot hold what it declares:
+// - any file: empty;
+// - PLY (ASCII or binary): a header that is not exactly the documented
+//   keywords and types (Assimp can loop forever on some), an element count,
+//   or a list length of any element instance, that needs more bytes than
+//   remain (truncated data included);
+// - binary STL (a file not starting with "solid"): a size other than the
+//   84 + 50 * triangle_count bytes its header declares.
+// `extension` is lower case with its dot (".ply").
+void check_declared_sizes(const std::string& path, const std::string& extension, std::string_view bytes);
+
+}  // namespace rtcl

@@ -1,0 +1,110 @@
+// Resource limits: a job larger than the device allows (largest buffer,
+// global memory) is refused before its upload with both numbers; the limits
+// can be lowered with RTCL_MAX_ALLOC_BYTES / RTCL_MAX_GLOBAL_BYTES; device
+// out-of-memory codes become errors that say what to do.
+#include "rtcl/cl/device_limits.hpp"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <string>
+#include <vector>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/cl/opencl.hpp"
+#include "rtcl/io/ray_file.hpp"
+#include "support/cli_run.hpp"
+#include "support/error_of.hpp"
+#include "support/fixtures.hpp"
+
+namespace rtcl::test {
+namespace {
+
+// Sets an environment variable for one scope.
+class ScopedEnv {
+ public:
+  ScopedEnv(const char* name, const char* value) : name_(name) { ::setenv(name, value, 1); }
+  ~ScopedEnv() { ::unsetenv(name_); }
+
+ private:
+  const char* name_;
+};
+
+TEST(DeviceLimits, RefusalsGiveBothNumbers) {
+  DeviceLimits limits{1000, 5000};
+  EXPECT_EQ(error_of([&] { check_allocation(limits, 1000, 3999, "nodes", "dev"); }), "");
+  std::string e = error_of([&] { check_allocation(limits, 1001, 0, "nodes", "dev"); });
+  EXPECT_EQ(e, "nodes: 1001 bytes exceed the largest buffer dev allows (1000 bytes)");
+  e = error_of([&] { check_allocation(limits, 1000, 4001, "rays", "dev"); });
+  EXPECT_EQ(e, "rays: 1000 bytes, with the 4001 bytes rtcl already holds there, exceed the global memory of dev "
+               "(5000 bytes)");
+}
+
+TEST(DeviceLimits, EnvironmentOnlyLowersLimits) {
+  {
+    ScopedEnv alloc("RTCL_MAX_ALLOC_BYTES", "4096");
+    ScopedEnv global("RTCL_MAX_GLOBAL_BYTES", "999999999999999");
+    DeviceLimits l = limits_with_overrides({1 << 20, 1 << 30});
+    EXPECT_EQ(l.max_alloc_bytes, 4096u);
+    EXPECT_EQ(l.global_mem_bytes, std::size_t(1) << 30) << "a larger value never raises a limit";
+  }
+  for (const char* bad : {"lots", "-5", "0", "12k"}) {
+    ScopedEnv alloc("RTCL_MAX_ALLOC_BYTES", bad);
+    std::string e = error_of([] { limits_with_overrides({1 << 20, 1 << 30}); });
+    EXPECT_NE(e.find(std::string("RTCL_MAX_ALLOC_BYTES='") + bad + "': expected a positive number of bytes"),
+              std::string::npos)
+        << e;
+  }
+}
+
+TEST(DeviceLimits, AStructureLargerThanTheLargestBufferIsRefused) {
+  ScopedEnv alloc("RTCL_MAX_ALLOC_BYTES", "4096");
+  Device device = Device::open();
+  EXPECT_EQ(device.info().max_alloc_bytes, 4096u);
+  Geometry soup = random_soup(1000, 3);
+  for (const std::string& name : accel_names()) {
+    std::string e = error_of([&] { make_accel(device, name, soup); });
+    EXPECT_NE(e.find("bytes exceed the largest buffer " + device.info().name + " allows (4096 bytes)"),
+              std::string::npos)
+        << name << ": " << e;
+  }
+}
+
+// Live buffers count against global memory until they are released.
+TEST(DeviceLimits, GlobalMemoryCountsLiveBuffers) {
+  ScopedEnv global("RTCL_MAX_GLOBAL_BYTES", "1000000");
+  Device device = Device::open();
+  EXPECT_EQ(device.info().global_mem_bytes, 1000000u);
+  std::string e;
+  {
+    cl::Buffer first = device.allocate(600000, "first");
+    e = error_of([&] { device.allocate(600000, "second"); });
+    EXPECT_EQ(e, "second: 600000 bytes, with the 600000 bytes rtcl already holds there, exceed the global memory "
+                 "of " + device.info().name + " (1000000 bytes)");
+  }
+  EXPECT_EQ(error_of([&] { device.allocate(600000, "after release"); }), "") << "the first buffer was released";
+}
+
+TEST(DeviceLimits, OutOfMemoryCodesSayWhatToDo) {
+  for (int code : {CL_MEM_OBJECT_ALLOCATION_FAILURE, CL_OUT_OF_RESOURCES}) {
+    std::string e = error_of([&] { with_cl_errors([&] { throw cl::Error(code, "clEnqueueNDRangeKernel"); }); });
+    EXPECT_NE(e.find("clEnqueueNDRangeKernel failed: " + std::string(cl_error_name(code))), std::string::npos) << e;
+    EXPECT_NE(e.find("the device ran out of memory"), std::string::npos) << e;
+  }
+}
+
+TEST(DeviceLimits, TraceRefusesARaySetTooLargeForTheDeviceBeforeUploading) {
+  TempDir dir;
+  dir.write("mesh.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  std::vector<Ray> rays(400, Ray{0.2f, 0.2f, -1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 10.0f});
+  write_rays(dir.file("in.rays"), rays);
+  CliRun run = run_cli(dir, {"trace", "mesh.obj", "in.rays", "-o", "out.hits"}, "RTCL_MAX_ALLOC_BYTES=8192");
+  expect_failure(run, "ray buffer for in.rays: 12800 bytes exceed the largest buffer", dir, "out.hits");
+  EXPECT_NE(run.err.find("allows (8192 bytes)"), std::string::npos) << run.err;
+  EXPECT_EQ(run.out.find("accel:"), std::string::npos) << "refused before the structure was built: " << run.out;
+  run = run_cli(dir, {"trace", "mesh.obj", "in.rays", "-o", "out.hits"}, "RTCL_MAX_GLOBAL_BYTES=10000");
+  expect_failure(run, "exceed the global memory of", dir, "out.hits");
+}
+
+}  // namespace
+}  // namespace rtcl::test

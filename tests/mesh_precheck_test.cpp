@@ -1,0 +1,45 @@
+// The size checks made before Assimp reads a mesh accept every well-formed
+// file, at the tightest sizes, and name what a malformed one declares
+// (scene/mesh_precheck.hpp; whole-tool runs: malformed_files_test.cpp).
+#include "rtcl/scene/mesh_precheck.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+
+#include "support/error_of.hpp"
+
+namespace rtcl::test {
+namespace {
+
+const std::string header =
+    "ply\r\nformat ascii 1.0\ncomment c\nobj_info o\nelement vertex 3\nproperty float x\nproperty float y\n"
+    "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+TEST(MeshPrecheck, TightWellFormedFilesPass) {
+  // single digits and no final newline: the fewest bytes an ASCII body can have
+  EXPECT_EQ(error_of([] { check_declared_sizes("a.ply", ".ply", header + "0 0 0 1 0 0 0 1 0 3 0 1 2"); }), "");
+  std::string stl(80, 's');  // a binary header may start with anything but "solid"
+  stl += std::string("\x01\x00\x00\x00", 4) + std::string(50, '\0');
+  EXPECT_EQ(error_of([&] { check_declared_sizes("a.stl", ".stl", stl); }), "");
+  EXPECT_EQ(error_of([] { check_declared_sizes("a.stl", ".stl", "  solid x\nendsolid x\n"); }), "");
+  EXPECT_EQ(error_of([] { check_declared_sizes("a.obj", ".obj", "v"); }), "");
+}
+
+TEST(MeshPrecheck, MalformedFilesNameWhatTheyDeclare) {
+  std::string e = error_of([] { check_declared_sizes("a.ply", ".ply", header + "0 0 0 1 0 0 0 1 0 3 0 1"); });
+  EXPECT_NE(e.find("a.ply: PLY element 'face' 0 of 1: a list declares 3 entries, but only 4 bytes remain"), std::string::npos) << e;
+  e = error_of([] { check_declared_sizes("a.ply", ".ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty half x\n"
+                                                           "end_header\n"); });
+  EXPECT_NE(e.find("a.ply: PLY header line 4: unknown property type 'half'"), std::string::npos) << e;
+  e = error_of([] { check_declared_sizes("a.ply", ".ply", "ply\nformat ascii 1.0\nelement vertex 3\n"); });
+  EXPECT_NE(e.find("the file ends before 'end_header'"), std::string::npos) << e;
+  e = error_of([] { check_declared_sizes("a.stl", ".stl", std::string(83, 'x')); });
+  EXPECT_NE(e.find("a.stl: 83 bytes: neither an ASCII STL"), std::string::npos) << e;
+  EXPECT_NE(error_of([] { check_declared_sizes("a.obj", ".obj", ""); }).find("a.obj: the file is empty"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace rtcl::test
