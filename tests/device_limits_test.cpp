@@ -64,9 +64,10 @@ TEST(DeviceLimits, AStructureLargerThanTheLargestBufferIsRefused) {
   Geometry soup = random_soup(1000, 3);
   for (const std::string& name : accel_names()) {
     std::string e = error_of([&] { make_accel(device, name, soup); });
-    EXPECT_NE(e.find("bytes exceed the largest buffer " + device.info().name + " allows (4096 bytes)"),
-              std::string::npos)
-        << name << ": " << e;
+    // the device layer's message, or a structure's own refusal before any
+    // work (the grid checks its cell offsets first): both give both numbers
+    EXPECT_NE(e.find("largest buffer"), std::string::npos) << name << ": " << e;
+    EXPECT_NE(e.find("4096 bytes"), std::string::npos) << name << ": " << e;
   }
 }
 
