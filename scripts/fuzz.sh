@@ -31,7 +31,8 @@ done
 [ ${#targets[@]} -gt 0 ] || targets=(mesh_loader scene_file ray_file)
 
 bash scripts/setup.sh
-cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ >/dev/null
+[ -f build/librtcl.so ] || bash scripts/build.sh  # the fuzz targets link it for the structures' declarations
+cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DRTCL_LIBRARY="$PWD/build/librtcl.so" >/dev/null
 cmake --build build-fuzz -j "$(nproc)"
 
 # Leaks fail the run (libFuzzer's -detect_leaks); allocations above
