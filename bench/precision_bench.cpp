@@ -304,12 +304,11 @@ std::vector<std::string> traced_accels() {
 });
 
 [[maybe_unused]] const bool registered_closed = [] {
-  for (std::size_t i = 0; i < 4; ++i)
+  for (std::size_t i = 0; i < closed_cases().size(); ++i)
     for (Precision level : kLevels)
       for (const std::string& accel : traced_accels()) {
-        static const char* names[] = {"icosphere4", "cube8", "uvsphere", "icosphere4-far"};
         benchmark::RegisterBenchmark(
-            ("precision/closed/" + std::string(names[i]) + "/" + std::string(precision_name(level)) + "/" + accel)
+            ("precision/closed/" + closed_cases()[i].name + "/" + std::string(precision_name(level)) + "/" + accel)
                 .c_str(),
             closed_benchmark, i, level, accel)
             ->Iterations(1)

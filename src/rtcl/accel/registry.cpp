@@ -63,7 +63,7 @@ std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, c
   full.options = spec.options;
   for (const auto& [option, value] : config.options.values()) full.options.set(option, value);
   full.options = resolve_options(structure_spec(spec.name), full.options, "--accel " + std::string(name));
-  require_precision(device.info(), config.precision);
+  require_precision(device.info(), config.precision);  // before the build (the Accel base checks again for direct factories)
   for (const Entry& entry : registry())
     if (entry.spec.name == spec.name) return entry.make(device, geometry, full);
   throw Error("internal: structure " + spec.name + " has no factory");
