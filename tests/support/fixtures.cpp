@@ -2,7 +2,9 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <random>
+#include <string>
 
 namespace rtcl::test {
 
@@ -19,9 +21,28 @@ const Device& test_device() {
 }
 
 std::vector<Precision> test_precisions() {
-  std::vector<Precision> levels;
-  for (Precision p : {Precision::robust, Precision::exact, Precision::fast})
-    if (precision_unsupported(test_device().info(), p).empty()) levels.push_back(p);
+  static const std::vector<Precision> levels = [] {
+    std::vector<Precision> chosen = {Precision::robust, Precision::exact, Precision::fast};
+    if (const char* list = std::getenv("RTCL_TEST_PRECISIONS")) {
+      chosen.clear();
+      std::string text = list;
+      for (std::size_t begin = 0; begin <= text.size();) {
+        std::size_t end = std::min(text.find(',', begin), text.size());
+        std::string name = text.substr(begin, end - begin);
+        try {
+          chosen.push_back(parse_precision(name));
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "FATAL: RTCL_TEST_PRECISIONS=%s: %s\n", list, e.what());
+          std::abort();
+        }
+        begin = end + 1;
+      }
+    }
+    std::vector<Precision> supported;
+    for (Precision p : chosen)
+      if (precision_unsupported(test_device().info(), p).empty()) supported.push_back(p);
+    return supported;
+  }();
   return levels;
 }
 

@@ -18,7 +18,10 @@ namespace rtcl::test {
 const Device& test_device();
 
 // Every precision level the test device supports, robust first (exact
-// needs fp64: PoCL has it, so CI runs all three).
+// needs fp64: PoCL has it, so CI runs all three). RTCL_TEST_PRECISIONS
+// (e.g. "robust" or "robust,exact") narrows the list for the registry-wide
+// suites: the sanitizer run uses it, because the levels differ only in
+// device code, which the sanitizers do not instrument.
 std::vector<Precision> test_precisions();
 
 // Absolute path of a file under ../shared/scenes.
