@@ -47,7 +47,9 @@ def option_order(option):
         return (0, float(value))
     if name == "res":
         return (1, int(value.split("x")[0]))
-    return (2, 0)
+    if name == "macro":
+        return (2, int(value))
+    return (3, 0)
 
 
 def markdown(table):

@@ -139,7 +139,7 @@ void scene_benchmark(benchmark::State& state, const std::string& scene_name, Pre
     PrecisionScene& p = precision_scene(scene_name);
     std::string key = std::string(precision_name(level)) + "/" + accel_name;
     auto& accel = p.accels[key];
-    if (!accel) accel = make_accel(bench_device(), accel_name, p.scene->geometry, {level});
+    if (!accel) accel = make_accel(bench_device(), accel_name, p.scene->geometry, {level, {}});
     std::size_t count = p.scene->primary.rays.size();
     accel->trace(Query::closest, p.rays, p.hits, count).wait();  // warm-up: code generation
     for (auto _ : state) {
@@ -199,7 +199,7 @@ const std::vector<ClosedCase>& closed_cases() {
 void closed_benchmark(benchmark::State& state, std::size_t index, Precision level, const std::string& accel_name) {
   try {
     const ClosedCase& c = closed_cases()[index];
-    auto accel = make_accel(bench_device(), accel_name, c.mesh, {level});
+    auto accel = make_accel(bench_device(), accel_name, c.mesh, {level, {}});
     std::vector<Hit> hits;
     for (auto _ : state) hits = trace_all(*accel, c.rays, Query::closest);
     std::size_t leaks = 0;
@@ -265,7 +265,7 @@ void render_benchmark(benchmark::State& state, const RenderCase& c, Precision le
     auto it = references.find(c.name);
     if (it == references.end()) it = references.emplace(c.name, test::reference_render(scene, settings)).first;
     const test::ReferenceImage& ref = it->second;
-    Renderer renderer(bench_device(), scene, "bvh", {level});
+    Renderer renderer(bench_device(), scene, "bvh", {level, {}});
     Image image;
     for (auto _ : state) image = renderer.render(settings);
     std::vector<std::uint8_t> excused = test::edge_pixels(ref.image, 0.05, 1);

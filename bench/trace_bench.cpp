@@ -4,8 +4,9 @@
 //     primary, shadow, diffuse (pixel order) and primary-tiled, shadow-morton,
 //     diffuse-morton (the same rays reordered for packets)
 //   sweep/<scene>/<kind>/grid/<option>=<value>   the same for the grid built
-//     with that option (lambda=..., res=AxBxC): the lecture's trade-off of
-//     cell count against list length (bench/plot_sweep.py plots it)
+//     with that option (lambda=..., res=AxBxC, macro=...): the lecture's
+//     trade-off of cell count against list length, and the macrocell size
+//     (bench/plot_sweep.py plots it)
 // Kernel time comes from OpenCL event profiling (COMMAND_START .. COMMAND_END)
 // and is reported as manual time; a warm-up launch first absorbs PoCL's
 // compile-on-first-launch. Brute force traces a subset (brute_ray_limit()).
@@ -186,6 +187,7 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
   std::vector<std::string> options;
   for (const char* l : lambdas) options.push_back(std::string("lambda=") + l);
   for (const char* r : cubes) options.push_back(std::string("res=") + r);
+  for (const char* m : {"1", "2", "8", "16"}) options.push_back(std::string("macro=") + m);
   for (RayKind kind : {RayKind::primary, RayKind::diffuse})
     for (const std::string& option : options)
       benchmark::RegisterBenchmark(

@@ -202,6 +202,58 @@ TEST(GridBuild, ListsEveryOverlappingCellAndOffsetsAreCompact) {
       }
 }
 
+TEST(GridBuild, MacrocellsOccupiedBoxesAndLanesFollowTheCellLists) {
+  Geometry g = soup_with_spheres(300, 5);
+  GridConfig config = with_res(9, 7, 5);
+  config.macro = 2;
+  Grid grid = build_grid(g, config);
+  const GridHeader& h = grid.header;
+  ASSERT_EQ(h.macro[3], 1);
+  ASSERT_EQ(h.macro[0], 5);
+  ASSERT_EQ(h.macro[1], 4);
+  ASSERT_EQ(h.macro[2], 3);
+  std::vector<int> expected_occupied(grid.occupied.size(), 0);
+  auto inside = [](const float* rows, int lane, const glm::vec3& lo, const glm::vec3& hi) {
+    for (int a = 0; a < 3; ++a)
+      if (!(rows[a * 8 + lane] <= lo[a] && hi[a] <= rows[(3 + a) * 8 + lane])) return false;
+    return true;
+  };
+  for (int k = 0; k < h.res[2]; ++k)
+    for (int j = 0; j < h.res[1]; ++j)
+      for (int i = 0; i < h.res[0]; ++i) {
+        std::size_t c = i + h.res[0] * (j + h.res[1] * k);
+        if (grid.cell_begin[c + 1] == grid.cell_begin[c]) continue;
+        expected_occupied[(i >> 1) + h.macro[0] * ((j >> 1) + h.macro[1] * (k >> 1))] = 1;
+        // The cell lies in the occupied box of its octant and of its sub-octant.
+        glm::vec3 lo(plane(h, 0, i), plane(h, 1, j), plane(h, 2, k));
+        glm::vec3 hi(plane(h, 0, i + 1), plane(h, 1, j + 1), plane(h, 2, k + 1));
+        int octant = (i >= h.res[0] / 2) | (j >= h.res[1] / 2) << 1 | (k >= h.res[2] / 2) << 2;
+        EXPECT_TRUE(inside(&h.occupied_bounds[0][0], octant, lo, hi)) << "cell " << c;
+        bool in_sub = false;
+        for (int sub = 0; sub < 8; ++sub) in_sub |= inside(&grid.occupied_boxes[octant * 48], sub, lo, hi);
+        EXPECT_TRUE(in_sub) << "cell " << c;
+      }
+  for (std::size_t m = 0; m < grid.occupied.size(); ++m) EXPECT_EQ(grid.occupied[m], expected_occupied[m]) << m;
+  // Lane k holds reference k's triangle; sphere references and the padding
+  // past the last reference are NaN with id -1.
+  const std::size_t stride = static_cast<std::size_t>(h.lane_stride);
+  ASSERT_EQ(stride, grid.refs.size() + 8);
+  std::vector<std::uint32_t> ids = stored_primitives(g);
+  for (std::size_t k = 0; k < stride; ++k) {
+    rtcl_i32 r = k < grid.refs.size() ? grid.refs[k] : -1;
+    if (r < 0) {
+      EXPECT_EQ(grid.lane_prims[k], -1);
+      for (int row = 0; row < 9; ++row) EXPECT_TRUE(std::isnan(grid.lanes[row * stride + k]));
+      continue;
+    }
+    std::uint32_t id = ids[static_cast<std::size_t>(r)];
+    EXPECT_EQ(grid.lane_prims[k], static_cast<rtcl_i32>(id));
+    const glm::uvec3& tri = g.triangles[id];
+    for (int v = 0; v < 3; ++v)
+      for (int a = 0; a < 3; ++a) EXPECT_EQ(grid.lanes[(3 * v + a) * stride + k], g.vertices[tri[v]][a]);
+  }
+}
+
 TEST(GridBuild, TrianglesOnACellPlaneAreListedOnBothSides) {
   // Unit cube grid 4x4x4 over [0, 4]^3 (dyadic planes): a triangle in the
   // plane x = 2 belongs to the cells with i = 1 and i = 2.
@@ -268,6 +320,31 @@ TEST(GridTrace, MatchesBruteForceOnCellBoundaryRays) {
     GridConfig config = with_res(res[0], res[1], res[2]);
     std::vector<Ray> rays = cell_boundary_rays(build_grid(g, config), 22, 3000);
     for (Precision level : kLevels) expect_same_as_brute(g, rays, config, level);
+  }
+}
+
+TEST(GridTrace, EveryMacrocellSizeMatchesBruteForceOnASparseScene) {
+  // Small triangles in a few clusters, so that rays cross empty macrocells
+  // and enter occupied ones through their faces, edges and corners.
+  Geometry g;
+  g.source = "clustered soup";
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  const glm::vec3 centres[] = {{0.1f, 0.1f, 0.1f}, {0.9f, 0.5f, 0.2f}, {0.5f, 0.9f, 0.9f}, {0.2f, 0.8f, 0.4f}};
+  for (const glm::vec3& centre : centres)
+    for (int t = 0; t < 150; ++t) {
+      glm::vec3 c = centre + 0.08f * glm::vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f);
+      std::uint32_t b = static_cast<std::uint32_t>(g.vertices.size());
+      for (int v = 0; v < 3; ++v)
+        g.vertices.push_back(c + 0.02f * glm::vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f));
+      g.triangles.push_back({b, b + 1, b + 2});
+    }
+  g.spheres.push_back({glm::vec3(0.8f, 0.2f, 0.8f), 0.05f});
+  for (unsigned macro : {1u, 2u, 8u}) {
+    GridConfig config = with_res(40, 24, 32);
+    config.macro = macro;
+    std::vector<Ray> rays = cell_boundary_rays(build_grid(g, config), 42 + macro, 3000);
+    for (Precision level : {Precision::robust, Precision::exact}) expect_same_as_brute(g, rays, config, level);
   }
 }
 

@@ -32,7 +32,9 @@ RTCL_PROBE_FIELD(Bvh8Node, bounds[5][7]) RTCL_PROBE_FIELD(Bvh8Node, child)
 
 RTCL_PROBE_RECORD(GridHeader)
 RTCL_PROBE_FIELD(GridHeader, lower) RTCL_PROBE_FIELD(GridHeader, cell) RTCL_PROBE_FIELD(GridHeader, res)
-RTCL_PROBE_FIELD(GridHeader, res[2])
+RTCL_PROBE_FIELD(GridHeader, res[2]) RTCL_PROBE_FIELD(GridHeader, macro)
+RTCL_PROBE_FIELD(GridHeader, macro[3]) RTCL_PROBE_FIELD(GridHeader, lane_stride)
+RTCL_PROBE_FIELD(GridHeader, occupied_bounds) RTCL_PROBE_FIELD(GridHeader, occupied_bounds[5][7])
 
 RTCL_PROBE_VALUE(RTCL_BLOCK_WIDTH)
 RTCL_PROBE_VALUE(RTCL_CHILD_EMPTY)

@@ -27,13 +27,14 @@ inline void rtcl_widen_slab(float8* tn, float8* tf) {
 #endif
 }
 
-/* Slab test of the ray against the node's eight child boxes over
- * [tmin, tmax]. Returns the hit mask (lane = -1 where hit) and the entry
+/* Slab test of the ray against eight boxes over [tmin, tmax], given as six
+ * float8 rows (lower x, y, z, upper x, y, z; the Bvh8Node bounds layout).
+ * Returns the hit mask (lane = -1 where hit) and the entry and exit
  * distances. Empty slots (lower = +inf, upper = -inf) never hit. Each axis's
  * distance enters a chain that starts from tmin or tmax, which are never
  * NaN, so tn and tf are not either. */
-inline int8 intersect_boxes8(global const Bvh8Node* node, const TraceRay* s, float tmax, float8* t_entry) {
-  global const float8* b = (global const float8*)node->bounds;
+inline int8 intersect_box_rows8(global const float8* b, const TraceRay* s, float tmax, float8* t_entry,
+                                float8* t_exit) {
   float8 tnx = (b[s->near_x] - s->ox) * s->ix;
   float8 tny = (b[s->near_y] - s->oy) * s->iy;
   float8 tnz = (b[s->near_z] - s->oz) * s->iz;
@@ -44,7 +45,14 @@ inline int8 intersect_boxes8(global const Bvh8Node* node, const TraceRay* s, flo
   float8 tf = rtcl_fmin8(tfx, rtcl_fmin8(tfy, rtcl_fmin8(tfz, (float8)(tmax))));
   rtcl_widen_slab(&tn, &tf);
   *t_entry = tn;
+  *t_exit = tf;
   return tn <= tf;
+}
+
+/* The same for the eight child boxes of a BVH node. */
+inline int8 intersect_boxes8(global const Bvh8Node* node, const TraceRay* s, float tmax, float8* t_entry) {
+  float8 t_exit;
+  return intersect_box_rows8((global const float8*)node->bounds, s, tmax, t_entry, &t_exit);
 }
 
 #endif

@@ -75,12 +75,33 @@ typedef struct Bvh8Node {
  * kernel alike; its index is i + res[0] * (j + res[1] * k). Its references
  * are refs[cell_begin[c] .. cell_begin[c + 1]) (compact grid, Lagae & Dutre
  * 2008): triangles first, as r >= 0 (lane r & 7 of triangle block r >> 3,
- * id-ordered blocks), then spheres, as ~r < 0 (sphere block array). 48 bytes;
- * element [3] of each row is unused. */
+ * id-ordered blocks), then spheres, as ~r < 0 (sphere block array).
+ * Macrocells (empty-space skipping): cells are grouped into cubes of
+ * 2^macro[3] cells per side, macrocell (I, J, K) holding the cells (i, j, k)
+ * with i >> macro[3] == I (and so on; the last ones per axis may be
+ * partial), index I + macro[0] * (J + macro[1] * K); occupied[m] is 1 when
+ * one of its cells has a reference, else 0. Reference lanes (so that a
+ * cell's triangles load as contiguous float8 runs, no gather): row
+ * 3 * vertex + axis of a float array with rows lane_stride apart holds, at
+ * position k, that coordinate of the triangle of reference k (NaN where
+ * reference k is a sphere, and in the 8 positions past the last
+ * reference), and lane_prims[k] its primitive id (-1 there). Occupied
+ * space: occupied_bounds (Bvh8Node bounds layout) holds, for each octant of
+ * the grid split at cell res / 2 on every axis, the box of its cells that
+ * have references, on cell planes (empty slot: lower +inf, upper -inf);
+ * every primitive lies in their union. A second array, occupied_boxes,
+ * holds 8 such row sets: set o the boxes of octant o's own octants (split
+ * at the middle cell of its range per axis), whose union is octant o's
+ * box's occupied part. 272 bytes; element [3] of lower,
+ * cell and res is unused. */
 typedef struct GridHeader {
+  float occupied_bounds[6][RTCL_BLOCK_WIDTH]; /* first: float8 rows, 32-byte aligned */
   float lower[4];
-  float cell[4];  /* cell size per axis, > 0 */
-  rtcl_i32 res[4]; /* cells per axis, >= 1 */
+  float cell[4];     /* cell size per axis, > 0 */
+  rtcl_i32 res[4];   /* cells per axis, >= 1 */
+  rtcl_i32 macro[4]; /* macrocells per axis, >= 1; [3]: log2 of a macrocell's side in cells */
+  rtcl_i32 lane_stride; /* references + 8 */
+  rtcl_i32 unused[3];
 } GridHeader;
 
 #ifndef __OPENCL_VERSION__

@@ -133,6 +133,25 @@ inline int intersect_triangles8(global const TriangleBlock* block, const TraceRa
                                   vload8(6 + s->ky, v), vload8(6 + s->kz, v), vload8(0, block->prim), s, h);
 }
 
+/* A run of up to eight triangles stored as lanes: row 3 * vertex + axis of
+ * `lanes` (rows `stride` floats apart) and `prims` hold, from position
+ * `first` on, count <= 8 triangles' coordinates and ids (GridHeader
+ * contract); lanes past count are replaced by NaN and never hit. Contiguous
+ * float8 loads, the arithmetic of a block: the same closest t, bit for
+ * bit. */
+inline int intersect_triangle_run(global const float* lanes, int stride, global const int* prims, uint first,
+                                  int count, const TraceRay* s, HitState* h) {
+  const int8 used = (int8)(0, 1, 2, 3, 4, 5, 6, 7) < (int8)(count);
+  global const float* p = lanes + first;
+#define RTCL_RUN_ROW(VERTEX, AXIS) select((float8)(NAN), vload8(0, p + (3 * (VERTEX) + (AXIS)) * stride), used)
+  const int found = intersect_triangle_lanes(RTCL_RUN_ROW(0, s->kx), RTCL_RUN_ROW(0, s->ky), RTCL_RUN_ROW(0, s->kz),
+                                             RTCL_RUN_ROW(1, s->kx), RTCL_RUN_ROW(1, s->ky), RTCL_RUN_ROW(1, s->kz),
+                                             RTCL_RUN_ROW(2, s->kx), RTCL_RUN_ROW(2, s->ky), RTCL_RUN_ROW(2, s->kz),
+                                             select((int8)(-1), vload8(0, prims + first), used), s, h);
+#undef RTCL_RUN_ROW
+  return found;
+}
+
 /* Up to eight referenced triangles: refs[0 .. count) index the triangles of
  * an id-ordered block array (reference r is lane r & 7 of block r >> 3, as
  * make_primitive_blocks_in_order lays them out); count <= 8. Lanes past
@@ -140,25 +159,27 @@ inline int intersect_triangles8(global const TriangleBlock* block, const TraceRa
  * closest t, bit for bit. */
 inline int intersect_triangle_refs(global const TriangleBlock* blocks, const int* refs, int count,
                                    const TraceRay* s, HitState* h) {
-  float lanes[9][8];
-  int prim[8];
-  const int axis[3] = {s->kx, s->ky, s->kz};
-  for (int l = 0; l < 8; ++l) {
-    if (l < count) {
-      global const TriangleBlock* b = blocks + (refs[l] >> 3);
-      int lane = refs[l] & 7;
-      for (int j = 0; j < 3; ++j)
-        for (int k = 0; k < 3; ++k) lanes[3 * j + k][l] = b->v[j][axis[k]][lane];
-      prim[l] = b->prim[lane];
-    } else {
-      for (int r = 0; r < 9; ++r) lanes[r][l] = NAN;
-      prim[l] = -1;
-    }
-  }
-  return intersect_triangle_lanes(vload8(0, lanes[0]), vload8(0, lanes[1]), vload8(0, lanes[2]),
-                                  vload8(0, lanes[3]), vload8(0, lanes[4]), vload8(0, lanes[5]),
-                                  vload8(0, lanes[6]), vload8(0, lanes[7]), vload8(0, lanes[8]),
-                                  vload8(0, prim), s, h);
+  /* Lanes are gathered straight into float8 values (no private staging
+   * array: PoCL then keeps them in registers); lanes past count re-read
+   * reference 0 and are replaced by NaN. */
+  const int8 used = (int8)(0, 1, 2, 3, 4, 5, 6, 7) < (int8)(count);
+  const int8 r = (int8)(refs[0], count > 1 ? refs[1] : refs[0], count > 2 ? refs[2] : refs[0],
+                        count > 3 ? refs[3] : refs[0], count > 4 ? refs[4] : refs[0], count > 5 ? refs[5] : refs[0],
+                        count > 6 ? refs[6] : refs[0], count > 7 ? refs[7] : refs[0]);
+  const int8 at = (r >> 3) * (int)(sizeof(TriangleBlock) / sizeof(float)) + (r & 7);
+  global const float* base = (global const float*)blocks;
+#define RTCL_GATHER8(P) (P)[at.s0], (P)[at.s1], (P)[at.s2], (P)[at.s3], (P)[at.s4], (P)[at.s5], (P)[at.s6], (P)[at.s7]
+#define RTCL_VERTEX_AXIS(J, K) \
+  select((float8)(NAN), (float8)(RTCL_GATHER8(base + (3 * (J) + (K)) * RTCL_BLOCK_WIDTH)), used)
+  const int8 prim = select((int8)(-1), (int8)(RTCL_GATHER8((global const int*)base + 9 * RTCL_BLOCK_WIDTH)), used);
+  const int found = intersect_triangle_lanes(RTCL_VERTEX_AXIS(0, s->kx), RTCL_VERTEX_AXIS(0, s->ky),
+                                             RTCL_VERTEX_AXIS(0, s->kz), RTCL_VERTEX_AXIS(1, s->kx),
+                                             RTCL_VERTEX_AXIS(1, s->ky), RTCL_VERTEX_AXIS(1, s->kz),
+                                             RTCL_VERTEX_AXIS(2, s->kx), RTCL_VERTEX_AXIS(2, s->ky),
+                                             RTCL_VERTEX_AXIS(2, s->kz), prim, s, h);
+#undef RTCL_VERTEX_AXIS
+#undef RTCL_GATHER8
+  return found;
 }
 
 #endif

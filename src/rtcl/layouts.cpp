@@ -15,6 +15,9 @@ static_assert(sizeof(TriangleBlock) == 320 && offsetof(TriangleBlock, prim) == 2
 static_assert(sizeof(SphereBlock) == 160 && offsetof(SphereBlock, r) == 96 && offsetof(SphereBlock, prim) == 128);
 static_assert(sizeof(Bvh8Node) == 224 && offsetof(Bvh8Node, child) == 192);
 static_assert(sizeof(Bvh8Node) % 32 == 0, "nodes must start on float8 boundaries");
-static_assert(sizeof(GridHeader) == 48 && offsetof(GridHeader, cell) == 16 && offsetof(GridHeader, res) == 32);
+static_assert(sizeof(GridHeader) == 272 && offsetof(GridHeader, occupied_bounds) == 0 &&
+              offsetof(GridHeader, lower) == 192 && offsetof(GridHeader, cell) == 208 &&
+              offsetof(GridHeader, res) == 224 && offsetof(GridHeader, macro) == 240 &&
+              offsetof(GridHeader, lane_stride) == 256);
 
 }  // namespace rtcl

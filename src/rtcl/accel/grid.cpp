@@ -18,6 +18,10 @@ namespace {
 constexpr double kMaxAxisCells = 65536.0;
 // Cell indices are int on the device: cells < 2^31.
 constexpr std::uint64_t kMaxCells = 0x7fffffffu;
+constexpr unsigned kMaxMacro = 256;
+// Positions past the last reference lane: a float8 run starting at the last
+// reference stays inside its row.
+constexpr std::size_t kLanePadding = RTCL_BLOCK_WIDTH;
 
 std::string resolution_text(const GridResolution& r) {
   return std::to_string(r[0]) + "x" + std::to_string(r[1]) + "x" + std::to_string(r[2]);
@@ -146,6 +150,9 @@ Frame make_frame(const Geometry& geometry, const GridConfig& config, std::size_t
     if (explicit_res && (r < 1 || r > kMaxAxisCells))
       throw Error("grid: res=" + resolution_text(config.resolution) + ": every axis must be in [1, 65536]");
   *option = explicit_res ? "res=" + resolution_text(config.resolution) : "lambda=" + std::to_string(config.lambda);
+  if (config.macro < 1 || config.macro > kMaxMacro || (config.macro & (config.macro - 1)) != 0)
+    throw Error("grid: macro must be a power of two in [1, " + std::to_string(kMaxMacro) + "] (got " +
+                std::to_string(config.macro) + ")");
 
   Aabb box = geometry.bounds();
   glm::dvec3 lower(box.lower), upper(box.upper);
@@ -172,13 +179,21 @@ Frame make_frame(const Geometry& geometry, const GridConfig& config, std::size_t
     f.header.cell[a] = cell;
     while (plane(f.header, a, res[a]) < hi) f.header.cell[a] = std::nextafter(f.header.cell[a], FLT_MAX);
   }
+  int shift = 0;
+  while ((1u << shift) < config.macro) ++shift;
+  f.header.macro[3] = shift;
+  for (int a = 0; a < 3; ++a) f.header.macro[a] = ((f.header.res[a] - 1) >> shift) + 1;
   return f;
 }
 
 }  // namespace
 
 std::size_t Grid::bytes() const {
-  return sizeof(GridHeader) + cell_begin.size() * sizeof(rtcl_u32) + refs.size() * sizeof(rtcl_i32) + blocks.bytes();
+  std::size_t spheres = blocks.spheres.empty() ? 0
+                                               : refs.size() * sizeof(rtcl_i32) + blocks.spheres.size() * sizeof(SphereBlock);
+  return sizeof(GridHeader) + cell_begin.size() * sizeof(rtcl_u32) + occupied.size() +
+         occupied_boxes.size() * sizeof(float) + lanes.size() * sizeof(float) +
+         lane_prims.size() * sizeof(rtcl_i32) + spheres;
 }
 
 GridResolution grid_resolution(const glm::dvec3& extent, std::size_t primitives, double lambda) {
@@ -217,7 +232,9 @@ Grid build_grid(const Geometry& geometry, const GridConfig& config) {
   std::string option;
   Frame f = make_frame(geometry, config, ids.size(), &option);
   std::size_t triangle_count = ids.size() - geometry.spheres.size();
-  std::size_t max_refs = config.max_alloc_bytes ? config.max_alloc_bytes / sizeof(rtcl_i32) : kMaxCells;
+  // The largest buffer is the reference lanes: 9 floats per reference.
+  std::size_t max_refs = config.max_alloc_bytes ? config.max_alloc_bytes / (9 * sizeof(float)) : kMaxCells;
+  max_refs = max_refs > kLanePadding ? max_refs - kLanePadding : 0;
   max_refs = std::min<std::size_t>(max_refs, kMaxCells);
 
   // Pass 1 (parallel over contiguous triangle ranges): (cell, ref) pairs.
@@ -260,8 +277,9 @@ Grid build_grid(const Geometry& geometry, const GridConfig& config) {
   std::size_t ref_count = 0;
   for (const auto& p : parts) ref_count += p.size();
   if (ref_count > max_refs || std::find(overflow.begin(), overflow.end(), 1) != overflow.end())
-    too_large(geometry, option, "more than " + std::to_string(max_refs) + " cell references",
-              std::uint64_t(max_refs + 1) * sizeof(rtcl_i32), max_refs * sizeof(rtcl_i32));
+    too_large(geometry, option, "more than " + std::to_string(max_refs) + " cell references (9 floats each)",
+              std::uint64_t(max_refs + 1 + kLanePadding) * 9 * sizeof(float),
+              (max_refs + kLanePadding) * 9 * sizeof(float));
 
   // Pass 2: counting sort by cell, stable (triangles, in id order, before
   // spheres in every cell).
@@ -276,7 +294,63 @@ Grid build_grid(const Geometry& geometry, const GridConfig& config) {
   std::vector<rtcl_u32> next(grid.cell_begin.begin(), grid.cell_begin.end() - 1);
   for (const auto& p : parts)
     for (const CellRef& r : p) grid.refs[next[r.cell]++] = r.ref;
+  GridHeader& h = grid.header;
+  const int shift = h.macro[3];
+  grid.occupied.assign(std::size_t(h.macro[0]) * h.macro[1] * h.macro[2], 0);
+  // Occupied space, two levels: the octants of the grid (split at cell
+  // res / 2 per axis), and the octants of each octant (split at the middle
+  // cell of its range); each box spans its cells that have references.
+  std::int64_t lo[64][3], hi[64][3];
+  for (int o = 0; o < 64; ++o)
+    for (int a = 0; a < 3; ++a) lo[o][a] = std::numeric_limits<std::int64_t>::max(), hi[o][a] = -1;
+  for (std::int64_t k = 0, c = 0; k < h.res[2]; ++k)
+    for (std::int64_t j = 0; j < h.res[1]; ++j)
+      for (std::int64_t i = 0; i < h.res[0]; ++i, ++c) {
+        if (grid.cell_begin[c + 1] == grid.cell_begin[c]) continue;
+        grid.occupied[(i >> shift) + h.macro[0] * ((j >> shift) + std::int64_t(h.macro[1]) * (k >> shift))] = 1;
+        const std::int64_t at[3] = {i, j, k};
+        int octant = 0, sub = 0;
+        for (int a = 0; a < 3; ++a) {
+          std::int64_t half = h.res[a] / 2;
+          bool upper = at[a] >= half;
+          std::int64_t mid = upper ? half + (h.res[a] - half) / 2 : half / 2;
+          octant |= (upper ? 1 : 0) << a;
+          sub |= (at[a] >= mid ? 1 : 0) << a;
+        }
+        for (int box : {octant * 8 + sub}) 
+          for (int a = 0; a < 3; ++a) lo[box][a] = std::min(lo[box][a], at[a]), hi[box][a] = std::max(hi[box][a], at[a]);
+      }
+  auto set_box = [&](float* rows, int lane, const std::int64_t* l, const std::int64_t* u) {
+    for (int a = 0; a < 3; ++a) {
+      bool empty = u[a] < 0;
+      rows[a * RTCL_BLOCK_WIDTH + lane] = empty ? std::numeric_limits<float>::infinity() : plane(h, a, l[a]);
+      rows[(3 + a) * RTCL_BLOCK_WIDTH + lane] = empty ? -std::numeric_limits<float>::infinity() : plane(h, a, u[a] + 1);
+    }
+  };
+  grid.occupied_boxes.assign(8 * 6 * RTCL_BLOCK_WIDTH, 0.0f);
+  for (int o = 0; o < 8; ++o) {
+    std::int64_t ol[3], ou[3];
+    for (int a = 0; a < 3; ++a) ol[a] = std::numeric_limits<std::int64_t>::max(), ou[a] = -1;
+    for (int sub = 0; sub < 8; ++sub) {
+      set_box(&grid.occupied_boxes[o * 6 * RTCL_BLOCK_WIDTH], sub, lo[o * 8 + sub], hi[o * 8 + sub]);
+      for (int a = 0; a < 3; ++a)
+        if (hi[o * 8 + sub][a] >= 0) ol[a] = std::min(ol[a], lo[o * 8 + sub][a]), ou[a] = std::max(ou[a], hi[o * 8 + sub][a]);
+    }
+    set_box(&h.occupied_bounds[0][0], o, ol, ou);
+  }
   grid.blocks = in_order_blocks(geometry, ids);
+  const std::size_t stride = grid.refs.size() + kLanePadding;
+  grid.header.lane_stride = static_cast<rtcl_i32>(stride);
+  grid.lanes.assign(9 * stride, std::numeric_limits<float>::quiet_NaN());
+  grid.lane_prims.assign(stride, -1);
+  for (std::size_t k = 0; k < grid.refs.size(); ++k) {
+    rtcl_i32 r = grid.refs[k];
+    if (r < 0) continue;
+    const TriangleBlock& b = grid.blocks.triangles[static_cast<std::size_t>(r) >> 3];
+    for (int v = 0; v < 3; ++v)
+      for (int a = 0; a < 3; ++a) grid.lanes[(3 * v + a) * stride + k] = b.v[v][a][r & 7];
+    grid.lane_prims[k] = b.prim[r & 7];
+  }
   return grid;
 }
 
@@ -290,24 +364,36 @@ class GridAccel final : public Accel {
         header_(device.upload(&grid.header, sizeof grid.header, "grid header")),
         cell_begin_(device.upload(grid.cell_begin.data(), grid.cell_begin.size() * sizeof(rtcl_u32),
                                   "grid cell offsets")),
-        refs_(grid.refs.empty() ? device.upload(&kNoRef, sizeof kNoRef, "grid references")
-                                : device.upload(grid.refs.data(), grid.refs.size() * sizeof(rtcl_i32),
-                                                "grid references")),
-        primitives_(upload(device, grid.blocks)) {}
+        refs_(grid.refs.empty() || grid.blocks.spheres.empty()
+                  ? device.upload(&kNoRef, sizeof kNoRef, "grid references")
+                  : device.upload(grid.refs.data(), grid.refs.size() * sizeof(rtcl_i32), "grid references")),
+        occupied_(device.upload(grid.occupied.data(), grid.occupied.size(), "grid macrocell occupancy")),
+        occupied_boxes_(device.upload(grid.occupied_boxes.data(), grid.occupied_boxes.size() * sizeof(float),
+                                      "grid occupied-space boxes")),
+        lanes_(device.upload(grid.lanes.data(), grid.lanes.size() * sizeof(float), "grid reference lanes")),
+        lane_prims_(device.upload(grid.lane_prims.data(), grid.lane_prims.size() * sizeof(rtcl_i32),
+                                  "grid reference primitive ids")),
+        spheres_(grid.blocks.spheres.empty()
+                     ? device.upload(&kNoSphere, sizeof kNoSphere, "grid spheres")
+                     : device.upload(grid.blocks.spheres.data(), grid.blocks.spheres.size() * sizeof(SphereBlock),
+                                     "grid spheres")) {}
 
  private:
   static constexpr rtcl_i32 kNoRef = 0;
+  static constexpr SphereBlock kNoSphere{};
 
   void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
     kernel.setArg(first, header_);
     kernel.setArg(first + 1, cell_begin_);
     kernel.setArg(first + 2, refs_);
-    kernel.setArg(first + 3, primitives_.triangles);
-    kernel.setArg(first + 4, primitives_.spheres);
+    kernel.setArg(first + 3, occupied_);
+    kernel.setArg(first + 4, occupied_boxes_);
+    kernel.setArg(first + 5, lanes_);
+    kernel.setArg(first + 6, lane_prims_);
+    kernel.setArg(first + 7, spheres_);
   }
 
-  cl::Buffer header_, cell_begin_, refs_;
-  DevicePrimitives primitives_;
+  cl::Buffer header_, cell_begin_, refs_, occupied_, occupied_boxes_, lanes_, lane_prims_, spheres_;
 };
 
 }  // namespace
@@ -336,7 +422,10 @@ const StructureSpec& grid_structure() {
         "cells per primitive (cells ~ lambda * N, split in proportion to the box): fewer cells make long cell "
         "lists, more make many empty cells to walk and 4 bytes of offsets per cell"},
        {"res", OptionType::resolution, GridResolution{0, 0, 0}, 1, 65536, false,
-        "explicit cells per axis AxBxC, overriding lambda; auto: from lambda"}}};
+        "explicit cells per axis AxBxC, overriding lambda; auto: from lambda"},
+       {"macro", OptionType::integer, static_cast<std::int64_t>(GridConfig{}.macro), 1, kMaxMacro, false,
+        "macrocell side in cells: the walk crosses an empty macrocell in one step; 1: cell by cell",
+        true}}};
   return spec;
 }
 
@@ -345,6 +434,7 @@ std::unique_ptr<Accel> make_grid_accel(const Device& device, const Geometry& geo
   GridConfig grid;
   grid.lambda = o.real("lambda");
   grid.resolution = o.resolution("res");
+  grid.macro = static_cast<unsigned>(o.integer("macro"));
   return make_grid(device, geometry, grid, config);
 }
 

@@ -29,6 +29,8 @@ bool parse_int(std::string_view text, std::int64_t* out) {
 }
 
 bool in_range(const OptionSpec& spec, double x) {
+  if (spec.power_of_two && !(x >= 1.0 && (static_cast<std::int64_t>(x) & (static_cast<std::int64_t>(x) - 1)) == 0))
+    return false;
   return (spec.min_exclusive ? x > spec.min : x >= spec.min) && x <= spec.max;
 }
 
@@ -130,7 +132,9 @@ std::string option_range_text(const OptionSpec& spec) {
   switch (spec.type) {
     case OptionType::boolean: return "";
     case OptionType::resolution: return "AxBxC with each axis in [" + lo + ", " + hi + "], or auto";
-    default: return spec.min_exclusive ? "> " + lo + " and <= " + hi : "in [" + lo + ", " + hi + "]";
+    default:
+      return std::string(spec.power_of_two ? "a power of two " : "") +
+             (spec.min_exclusive ? "> " + lo + " and <= " + hi : "in [" + lo + ", " + hi + "]");
   }
 }
 

@@ -36,6 +36,7 @@ struct OptionSpec {
   double min = 0.0, max = 0.0;
   bool min_exclusive = false;
   std::string help;  // what it controls and what it trades
+  bool power_of_two = false;  // integers only: the value must also be 2^n
 };
 
 // One structure in the registry: its name, one line on what it is, and its
