@@ -16,5 +16,8 @@ static_assert(sizeof(SphereBlock) == 160 && offsetof(SphereBlock, r) == 96 && of
 static_assert(sizeof(Bvh8Node) == 224 && offsetof(Bvh8Node, child) == 192);
 static_assert(sizeof(Bvh8Node) % 32 == 0, "nodes must start on float8 boundaries");
 static_assert(sizeof(GridHeader) == 48 && offsetof(GridHeader, cell) == 16 && offsetof(GridHeader, res) == 32);
+static_assert(sizeof(OctreeHeader) == 32 && offsetof(OctreeHeader, cell) == 16 && offsetof(OctreeHeader, top_digits) == 28);
+static_assert(sizeof(OctreeNode) == 48 && offsetof(OctreeNode, child) == 16);
+static_assert(sizeof(OctreePtrHeader) == 48 && offsetof(OctreePtrHeader, root) == 32);
 
 }  // namespace rtcl

@@ -1,0 +1,97 @@
+// Top-down octree subdivision shared by the three octrees (lecture, 八叉树:
+// "the scene in an axis-aligned cube, subdivided top-down into 2x2x2
+// children until a termination condition holds; primitives are stored only
+// in leaves, a primitive overlapping several leaves listed in each"). The
+// split planes come from a rule: the cube's centre for octree and
+// octree-ptr (src/rtcl/accel/octree.cpp), a cost heuristic for octree-r
+// (src/rtcl/accel/octree_r.cpp). The addressing (codes or pointers) is the
+// flatten step's business.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rtcl/accel/primitive_blocks.hpp"
+#include "rtcl/layouts.hpp"
+#include "rtcl/scene/geometry.hpp"
+
+namespace rtcl {
+
+struct OctreeBuildConfig {
+  std::string structure = "octree";  // named in errors
+  // Maximum depth N: the root is level 0, a node at level N is a leaf.
+  int max_depth = 8;
+  // A node with at most this many primitives is a leaf (k >= 1).
+  std::size_t leaf_size = 8;
+  // The largest buffer the device can allocate (0: no limit); the build
+  // stops with an Error as soon as the references or nodes exceed it.
+  std::size_t max_alloc_bytes = 0;
+};
+
+// A node of the build. Its box (lower, upper) is in float, each coordinate
+// exactly the value the kernel computes for it; children split it at
+// split[a] on every axis.
+struct OctreeBuildNode {
+  std::array<float, 3> lower{}, upper{}, split{};
+  int level = 0;
+  std::array<std::uint32_t, 3> lattice{};  // lower corner in lattice units (centre splits of a cube)
+  std::uint64_t digits = 0;                // q1 .. q_level, 3 bits each, q1 the highest
+  std::array<std::int32_t, 8> child{{-1, -1, -1, -1, -1, -1, -1, -1}};  // node indices; all -1 in a leaf
+  std::vector<rtcl_i32> refs;              // leaves only: triangles k >= 0 then spheres ~j (grid encoding)
+  bool leaf() const { return child[0] < 0; }
+};
+
+// The bounds of every stored primitive, by reference: triangle k of
+// stored_primitives at [k], sphere j at [triangle_count + j].
+struct PrimitiveBounds {
+  std::vector<glm::dvec3> lower, upper;
+  std::size_t triangle_count = 0;
+  std::size_t index(rtcl_i32 ref) const { return ref >= 0 ? std::size_t(ref) : triangle_count + std::size_t(~ref); }
+};
+
+struct OctreeBuild {
+  std::vector<OctreeBuildNode> nodes;  // nodes[0] is the root; children after their parents
+  PrimitiveBlocks blocks;              // in_order_blocks: what references index
+  std::size_t ref_count = 0;           // references over all leaves
+  std::size_t filled_leaves = 0;       // leaves with at least one reference
+  int depth = 0;                       // deepest level reached
+};
+
+// Chooses the split planes of `node`, an inner node to be, holding `refs`.
+using OctreeSplitRule = std::function<std::array<float, 3>(const OctreeBuildNode& node,
+                                                           const std::vector<rtcl_i32>& refs,
+                                                           const PrimitiveBounds& bounds)>;
+
+// The widening of every node box for the overlap tests (64 float ulps of
+// the scene's magnitude, as the grid's): covers the rounding of the
+// kernels' planes, slab distances and hit points, so that a primitive
+// touching or nearly touching a boundary is listed on both sides.
+double octree_widening(const Geometry& geometry);
+// The padding of the scene box before the root box is rounded outwards to
+// float (16 float ulps of the magnitude, as the grid's).
+double octree_padding(const Geometry& geometry);
+// The largest coordinate magnitude of the scene box.
+double scene_magnitude(const Geometry& geometry);
+
+// Validates config (Error "STRUCTURE: depth ..." / "leaf_size ...") and
+// subdivides the root box [lower, upper] over the stored primitives of
+// validated geometry. A node becomes a leaf at level max_depth, with at
+// most leaf_size primitives, or when no child would hold fewer primitives
+// than it (no progress); a primitive is listed in every child whose
+// widened closed box it meets (exact triangle/box and sphere/box tests).
+// `max_depth_limit` is what the structure's addressing can hold.
+OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float, 3>& lower,
+                               const std::array<float, 3>& upper, const OctreeBuildConfig& config,
+                               int max_depth_limit, const OctreeSplitRule& rule);
+
+// Checks the common options before any work: depth in [0, max_depth_limit]
+// and leaf_size >= 1, else Error naming the structure and the option.
+void check_octree_config(const OctreeBuildConfig& config, int max_depth_limit);
+
+}  // namespace rtcl
