@@ -29,7 +29,7 @@ namespace rtcl::test {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-const char* const kOctrees[] = {"octree", "octree-ptr", "octree-r"};
+const std::vector<std::string> kOctrees = {"octree", "octree-ptr", "octree-r"};
 
 Ray make_ray(glm::vec3 o, glm::vec3 d, float tmin = 0.0f, float tmax = kInf) {
   return {o.x, o.y, o.z, d.x, d.y, d.z, tmin, tmax};
@@ -42,29 +42,30 @@ std::string describe(const Ray& r, const Hit& got, const Hit& want) {
          " t " + std::to_string(want.t);
 }
 
-// `spec` (e.g. "octree:depth=4") and brute force answer both queries alike:
-// closest hits with the same primitive and t (bit for bit unless fast),
-// any hits with the same hit / miss.
-void expect_same_as_brute(const Geometry& g, const std::vector<Ray>& rays, const std::string& spec,
+// Each of `specs` (e.g. "octree:depth=4") and brute force answer both
+// queries alike: closest hits with the same primitive and t (bit for bit
+// unless fast), any hits with the same hit / miss.
+void expect_same_as_brute(const Geometry& g, const std::vector<Ray>& rays, const std::vector<std::string>& specs,
                           Precision level) {
   AccelConfig config{level};
   auto brute = make_brute(test_device(), g, config);
-  auto accel = make_accel(test_device(), spec, g, config);
   for (Query q : {Query::closest, Query::any}) {
-    SCOPED_TRACE(spec + (q == Query::closest ? " closest" : " any") + " at " + std::string(precision_name(level)) +
-                 " on " + g.source);
     auto want = run_query(*brute, rays, q);
-    auto got = run_query(*accel, rays, q);
-    std::size_t differ = 0;
-    std::string first;
-    for (std::size_t i = 0; i < rays.size(); ++i) {
-      bool same = (got[i].prim < 0) == (want[i].prim < 0);
-      if (same && q == Query::closest && got[i].prim >= 0)
-        same = level == Precision::fast ? std::fabs(got[i].t - want[i].t) <= 1e-5f * std::fabs(want[i].t)
-                                        : got[i].t == want[i].t && got[i].prim == want[i].prim;
-      if (!same && differ++ == 0) first = "ray " + std::to_string(i) + " " + describe(rays[i], got[i], want[i]);
+    for (const std::string& spec : specs) {
+      SCOPED_TRACE(spec + (q == Query::closest ? " closest" : " any") + " at " +
+                   std::string(precision_name(level)) + " on " + g.source);
+      auto got = run_query(*make_accel(test_device(), spec, g, config), rays, q);
+      std::size_t differ = 0;
+      std::string first;
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        bool same = (got[i].prim < 0) == (want[i].prim < 0);
+        if (same && q == Query::closest && got[i].prim >= 0)
+          same = level == Precision::fast ? std::fabs(got[i].t - want[i].t) <= 1e-5f * std::fabs(want[i].t)
+                                          : got[i].t == want[i].t && got[i].prim == want[i].prim;
+        if (!same && differ++ == 0) first = "ray " + std::to_string(i) + " " + describe(rays[i], got[i], want[i]);
+      }
+      EXPECT_EQ(differ, 0u) << "of " << rays.size() << " rays; first: " << first;
     }
-    EXPECT_EQ(differ, 0u) << "of " << rays.size() << " rays; first: " << first;
   }
 }
 
@@ -249,25 +250,65 @@ TEST(OctreeTrace, MatchesBruteForceOnSoupsAtEveryLevel) {
   std::vector<Ray> rays = random_rays(g, 800, 12);
   std::vector<Ray> planes = plane_rays(lattice_planes(g, 10, 5), g, 13, 1400);
   rays.insert(rays.end(), planes.begin(), planes.end());
-  for (Precision level : test_precisions())
-    for (const char* name : kOctrees) expect_same_as_brute(g, rays, name, level);
+  for (Precision level : test_precisions()) expect_same_as_brute(g, rays, kOctrees, level);
+}
+
+// Separate tiny triangles: a cluster 2^-15 across in a unit scene, which
+// only the deepest trees resolve, and two large parallel ones around it.
+Geometry tiny_cluster() {
+  std::vector<float> xyz;
+  std::vector<std::uint32_t> idx;
+  auto triangle = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c) {
+    std::uint32_t base = static_cast<std::uint32_t>(xyz.size() / 3);
+    for (const glm::vec3& v : {a, b, c}) xyz.insert(xyz.end(), {v.x, v.y, v.z});
+    idx.insert(idx.end(), {base, base + 1, base + 2});
+  };
+  const float step = 1.0f / 65536.0f;
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j)
+      for (int k = 0; k < 4; ++k) {
+        glm::vec3 o = glm::vec3(0.3f) + step * glm::vec3(i, j, k);
+        triangle(o, o + glm::vec3(0.5f * step, 0, 0), o + glm::vec3(0, 0.5f * step, 0.25f * step));
+      }
+  triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+  triangle({0, 0, 1}, {1, 0, 1}, {0, 1, 1});  // parallel to the first: no intersection line to resolve
+  return Geometry::from_arrays(xyz.data(), xyz.size() / 3, idx.data(), idx.size() / 3, "tiny cluster");
 }
 
 TEST(OctreeTrace, MatchesBruteForceOnSplitPlaneRaysOfEveryShape) {
   Geometry g = soup_with_spheres(1000, 21);
-  // shallow and coarse, one leaf, the deepest each representation holds
-  for (int depth : {0, 3, 16}) {
+  for (int depth : {0, 3}) {  // one leaf; shallow and coarse
     std::vector<Ray> rays = plane_rays(lattice_planes(g, depth, 6), g, 22 + depth, 1400);
-    std::string options = ":depth=" + std::to_string(depth) + ",leaf_size=" + (depth == 16 ? "1" : "4");
-    for (const char* name : {"octree", "octree-ptr"}) expect_same_as_brute(g, rays, name + options, Precision::robust);
+    std::string options = ":depth=" + std::to_string(depth) + ",leaf_size=4";
+    expect_same_as_brute(g, rays, {"octree" + options, "octree-ptr" + options}, Precision::robust);
   }
-  std::vector<Ray> deep = plane_rays(lattice_planes(g, 20, 6), g, 40, 700);
-  expect_same_as_brute(g, deep, "octree-ptr:depth=20,leaf_size=1", Precision::robust);
   OctreeRConfig r;
   r.leaf_size = 2;
   std::vector<Ray> rays = plane_rays(split_planes(build_octree_r(g, r)), g, 41, 1400);
-  expect_same_as_brute(g, rays, "octree-r:leaf_size=2", Precision::robust);
-  expect_same_as_brute(g, rays, "octree-r:depth=20,leaf_size=1,bins=4", Precision::robust);
+  expect_same_as_brute(g, rays, {"octree-r:leaf_size=2", "octree-r:depth=5,leaf_size=1,bins=4"}, Precision::robust);
+}
+
+TEST(OctreeTrace, TheDeepestTreesMatchBruteForce) {
+  Geometry g = tiny_cluster();
+  std::mt19937 rng(7);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  std::vector<Ray> rays = plane_rays(lattice_planes(g, 16, 16), g, 50, 600);
+  for (int i = 0; i < 600; ++i) {  // at the cluster, from afar and from within
+    glm::vec3 target = glm::vec3(0.3f) + (4.0f / 65536.0f) * glm::vec3(normal(rng), normal(rng), normal(rng));
+    glm::vec3 d(normal(rng), normal(rng), normal(rng));
+    rays.push_back(make_ray(i % 2 ? target - d : target, d));
+  }
+  OctreeConfig config;
+  config.max_depth = RTCL_OCTREE_MAX_DEPTH;
+  config.leaf_size = 1;
+  Octree tree = build_octree(g, config);
+  std::size_t deepest = 0;
+  for (std::uint64_t c : tree.codes) deepest += (c & 0xf) != 0xf;  // a last digit that is not F: level 16
+  EXPECT_GT(deepest, 0u);
+  expect_same_as_brute(g, rays,
+                       {"octree:depth=16,leaf_size=1", "octree:depth=16,leaf_size=1,buckets=false",
+                        "octree-ptr:depth=20,leaf_size=1", "octree-r:depth=20,leaf_size=1"},
+                       Precision::robust);
 }
 
 TEST(OctreeTrace, DyadicQuadsSeenAlongCellEdges) {
@@ -290,8 +331,8 @@ TEST(OctreeTrace, DyadicQuadsSeenAlongCellEdges) {
       rays.push_back(make_ray({1.0f, float(y), float(z)}, {1, 1, 1}));  // from a corner
     }
   for (Precision level : test_precisions())
-    for (const char* name : {"octree:depth=4,leaf_size=1", "octree-ptr:depth=4,leaf_size=1", "octree-r:leaf_size=1"})
-      expect_same_as_brute(g, rays, name, level);
+    expect_same_as_brute(g, rays, {"octree:depth=4,leaf_size=1", "octree-ptr:depth=4,leaf_size=1", "octree-r:leaf_size=1"},
+                         level);
 }
 
 TEST(OctreeTrace, FlatSceneAndTinyIntervals) {
@@ -303,7 +344,7 @@ TEST(OctreeTrace, FlatSceneAndTinyIntervals) {
   rays.push_back(make_ray({0.25f, 0.25f, 0.0f}, {0, 0, 1}, 0.0f, 0.5f));  // tmax exactly at the plane
   rays.push_back(make_ray({0.25f, 0.25f, 0.0f}, {0, 0, 1}, 0.0f, std::nextafter(0.5f, 0.0f)));
   rays.push_back(make_ray({-1.0f, 0.25f, 0.5f}, {1, 0, 0}));  // in the plane
-  for (const char* name : kOctrees) expect_same_as_brute(flat, rays, name, Precision::robust);
+  expect_same_as_brute(flat, rays, kOctrees, Precision::robust);
 }
 
 TEST(OctreeTrace, MatchesBruteForceAndReferenceOnTheBunny) {
@@ -320,11 +361,11 @@ TEST(OctreeTrace, MatchesBruteForceAndReferenceOnTheBunny) {
   }
   std::vector<Ray> planes = plane_rays(lattice_planes(g, 10, 6), g, 43, 500);
   rays.insert(rays.end(), planes.begin(), planes.end());
-  for (const char* name : kOctrees) expect_same_as_brute(g, rays, name, Precision::robust);
+  expect_same_as_brute(g, rays, kOctrees, Precision::robust);
   std::vector<Ray> some(rays.begin(), rays.begin() + 150);
   some.insert(some.end(), rays.end() - 150, rays.end());
   std::vector<Hit> references = reference_closest_all(g, some);
-  for (const char* name : kOctrees) {
+  for (const std::string& name : kOctrees) {
     auto accel = make_accel(test_device(), name, g);
     for (Query q : {Query::closest, Query::any}) {
       std::size_t failures = 0;
@@ -336,7 +377,7 @@ TEST(OctreeTrace, MatchesBruteForceAndReferenceOnTheBunny) {
 
 TEST(OctreeTrace, ReportsStats) {
   Geometry g = random_soup(1000, 4);
-  for (const char* name : kOctrees) {
+  for (const std::string& name : kOctrees) {
     auto accel = make_accel(test_device(), name, g);
     EXPECT_EQ(accel->name(), name);
     EXPECT_EQ(accel->stats().primitive_count, 1000u);

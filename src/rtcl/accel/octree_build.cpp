@@ -49,6 +49,25 @@ bool overlaps(const Geometry& geometry, const std::vector<std::uint32_t>& ids, c
   return sphere_box_overlap(glm::dvec3(s.center), s.radius, lo, hi);
 }
 
+double area(const std::array<double, 3>& e) { return 2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]); }
+
+// The cost test of OctreeBuildConfig::split_cost.
+bool pays(const OctreeBuildNode& node, const std::array<float, 3>& s, const std::array<std::vector<rtcl_i32>, 8>& parts,
+          double split_cost) {
+  std::array<double, 3> e;
+  for (int a = 0; a < 3; ++a) e[a] = double(node.upper[a]) - double(node.lower[a]);
+  double whole = area(e);
+  if (!(whole > 0.0)) return false;
+  double cost = split_cost;
+  for (int q = 0; q < 8; ++q) {
+    std::array<double, 3> c;
+    for (int a = 0; a < 3; ++a)
+      c[a] = (q >> a) & 1 ? double(node.upper[a]) - double(s[a]) : double(s[a]) - double(node.lower[a]);
+    cost += area(c) / whole * double(parts[q].size());
+  }
+  return cost < double(node.refs.size());
+}
+
 std::string options_text(const OctreeBuildConfig& c) {
   return "depth=" + std::to_string(c.max_depth) + ",leaf_size=" + std::to_string(c.leaf_size);
 }
@@ -128,7 +147,7 @@ OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float,
           if (overlaps(geometry, ids, bounds, r, lo, hi)) parts[q].push_back(r);
         progress = progress || parts[q].size() < node.refs.size();
       }
-      split = progress;
+      split = progress && (config.split_cost <= 0.0 || pays(node, s, parts, config.split_cost));
     }
     if (!split) {
       out.ref_count += node.refs.size();

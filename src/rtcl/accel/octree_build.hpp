@@ -29,6 +29,12 @@ struct OctreeBuildConfig {
   int max_depth = 8;
   // A node with at most this many primitives is a leaf (k >= 1).
   std::size_t leaf_size = 8;
+  // When > 0, a split is kept only when it lowers the estimated cost of a
+  // ray meeting the node, in units of one primitive test: split_cost (the
+  // traversal step) + sum over the children of area(child) / area(node) *
+  // primitives(child) < primitives(node) (Octree-R's surface-area model;
+  // it stops where no plane separates the primitives). 0: no cost test.
+  double split_cost = 0.0;
   // The largest buffer the device can allocate (0: no limit); the build
   // stops with an Error as soon as the references or nodes exceed it.
   std::size_t max_alloc_bytes = 0;
@@ -82,8 +88,8 @@ double scene_magnitude(const Geometry& geometry);
 // Validates config (Error "STRUCTURE: depth ..." / "leaf_size ...") and
 // subdivides the root box [lower, upper] over the stored primitives of
 // validated geometry. A node becomes a leaf at level max_depth, with at
-// most leaf_size primitives, or when no child would hold fewer primitives
-// than it (no progress); a primitive is listed in every child whose
+// most leaf_size primitives, when no child would hold fewer primitives
+// than it (no progress), or when the split does not pay (split_cost); a primitive is listed in every child whose
 // widened closed box it meets (exact triangle/box and sphere/box tests).
 // `max_depth_limit` is what the structure's addressing can hold.
 OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float, 3>& lower,

@@ -71,7 +71,9 @@ namespace {
 
 std::vector<std::string> ptr_defines(const Geometry& geometry, const OctreePtr& tree) {
   std::vector<std::string> defines = primitive_defines(geometry);
-  defines.push_back("RTCL_OCTREE_STACK=" + std::to_string(3 * tree.header.depth + 1));
+  // 3 entries per level and one; two sizes, so that trees of other depths
+  // share a program
+  defines.push_back(std::string("RTCL_OCTREE_STACK=") + (tree.header.depth <= 10 ? "31" : "61"));
   return defines;
 }
 

@@ -48,7 +48,10 @@ OctreePtr build_octree_r(const Geometry& geometry, const OctreeRConfig& config) 
   build.max_depth = config.max_depth;
   build.leaf_size = config.leaf_size;
   build.max_alloc_bytes = config.max_alloc_bytes;
+  build.split_cost = config.traversal_cost;
   check_octree_config(build, kOctreePtrMaxDepth);
+  if (!(config.traversal_cost > 0.0) || !std::isfinite(config.traversal_cost))
+    throw Error("octree-r: traversal_cost=" + std::to_string(config.traversal_cost) + ": must be > 0");
   if (config.bins < 2 || config.bins > 1024)
     throw Error("octree-r: bins=" + std::to_string(config.bins) + ": must be in [2, 1024]");
   // The root: the scene's padded box, rounded outwards (not a cube: free
@@ -104,7 +107,10 @@ const StructureSpec& octree_r_structure() {
        {"leaf_size", OptionType::integer, std::int64_t(OctreeRConfig{}.leaf_size), 1, 1 << 20, false,
         "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"},
        {"bins", OptionType::integer, std::int64_t(OctreeRConfig{}.bins), 2, 1024, false,
-        "candidate split planes per axis and node, plus one: more find cheaper planes at a longer build"}}};
+        "candidate split planes per axis and node, plus one: more find cheaper planes at a longer build"},
+       {"traversal_cost", OptionType::real, OctreeRConfig{}.traversal_cost, 0, 1000, true,
+        "cost of a traversal step in primitive tests: a node is split only when that lowers its estimated cost; "
+        "higher makes shallower trees with longer leaves"}}};
   return spec;
 }
 
@@ -115,6 +121,7 @@ std::unique_ptr<Accel> make_octree_r_accel(const Device& device, const Geometry&
   tree.max_depth = static_cast<int>(o.integer("depth"));
   tree.leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
   tree.bins = static_cast<int>(o.integer("bins"));
+  tree.traversal_cost = o.real("traversal_cost");
   return make_octree_r(device, geometry, tree, config);
 }
 

@@ -25,6 +25,9 @@ struct OctreeRConfig {
   // Candidate planes per axis and node: `bins` - 1 planes evenly spaced
   // inside the node; more find better planes at a longer build.
   int bins = 16;
+  // The cost of one traversal step in primitive tests: a split is kept only
+  // when it lowers the estimated cost (OctreeBuildConfig::split_cost).
+  double traversal_cost = 1.0;
   std::size_t max_alloc_bytes = 0;
 };
 
