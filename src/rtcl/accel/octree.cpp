@@ -93,6 +93,7 @@ Octree build_octree(const Geometry& geometry, const OctreeConfig& config) {
   build.structure = "octree";
   build.max_depth = config.max_depth;
   build.leaf_size = config.leaf_size;
+  build.ref_budget = config.ref_budget;
   build.max_alloc_bytes = config.max_alloc_bytes;
   check_octree_config(build, RTCL_OCTREE_MAX_DEPTH);
   Octree out;
@@ -216,6 +217,9 @@ const StructureSpec& octree_structure() {
         "shorter leaf lists, more cells to walk and more references"},
        {"leaf_size", OptionType::integer, std::int64_t(OctreeConfig{}.leaf_size), 1, 1 << 20, false,
         "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"},
+       {"ref_budget", OptionType::real, OctreeConfig{}.ref_budget, 1, 1e6, false,
+        "references per primitive the tree may hold: splits past it are not made (bounds memory where "
+        "surfaces meet along a line or at a point)"},
        {"buckets", OptionType::boolean, OctreeConfig{}.buckets, 0, 0, false,
         "index the code table by its first digits before the binary search (false: search the whole table)"}}};
   return spec;
@@ -226,6 +230,7 @@ std::unique_ptr<Accel> make_octree_accel(const Device& device, const Geometry& g
   OctreeConfig tree;
   tree.max_depth = static_cast<int>(o.integer("depth"));
   tree.leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
+  tree.ref_budget = o.real("ref_budget");
   tree.buckets = o.boolean("buckets");
   return make_octree(device, geometry, tree, config);
 }

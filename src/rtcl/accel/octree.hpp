@@ -26,6 +26,8 @@ struct OctreeConfig {
   int max_depth = 10;
   // Primitives a node may hold and still be a leaf (k >= 1).
   std::size_t leaf_size = 8;
+  // References per stored primitive the tree may hold (OctreeBuildConfig).
+  double ref_budget = 16.0;
   // Index the table by the first digits of a code (bucket_begin, about one
   // bucket per leaf) before the binary search; false: binary search over
   // the whole table.

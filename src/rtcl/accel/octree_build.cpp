@@ -103,6 +103,8 @@ void check_octree_config(const OctreeBuildConfig& config, int max_depth_limit) {
                 (config.structure == "octree" ? "64-bit node codes" : "traversal stack") + " can hold)");
   if (config.leaf_size < 1)
     throw Error(config.structure + ": leaf_size=" + std::to_string(config.leaf_size) + ": must be >= 1");
+  if (!(config.ref_budget >= 1.0) || !std::isfinite(config.ref_budget))
+    throw Error(config.structure + ": ref_budget=" + std::to_string(config.ref_budget) + ": must be >= 1");
 }
 
 OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float, 3>& lower,
@@ -113,6 +115,7 @@ OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float,
   PrimitiveBounds bounds = primitive_bounds(geometry, ids);
   const double widen = octree_widening(geometry);
   const std::size_t max_refs = config.max_alloc_bytes ? config.max_alloc_bytes / sizeof(rtcl_i32) : SIZE_MAX;
+  const double budget = std::max(1.0, config.ref_budget) * static_cast<double>(ids.size());
   const std::size_t max_nodes = config.max_alloc_bytes ? config.max_alloc_bytes / sizeof(OctreeNode) : SIZE_MAX;
 
   OctreeBuild out;
@@ -147,7 +150,10 @@ OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float,
           if (overlaps(geometry, ids, bounds, r, lo, hi)) parts[q].push_back(r);
         progress = progress || parts[q].size() < node.refs.size();
       }
-      split = progress && (config.split_cost <= 0.0 || pays(node, s, parts, config.split_cost));
+      std::size_t added = 0;
+      for (const auto& part : parts) added += part.size();
+      split = progress && out.ref_count + pending_refs - node.refs.size() + added <= budget &&
+              (config.split_cost <= 0.0 || pays(node, s, parts, config.split_cost));
     }
     if (!split) {
       out.ref_count += node.refs.size();

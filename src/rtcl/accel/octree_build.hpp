@@ -35,6 +35,13 @@ struct OctreeBuildConfig {
   // primitives(child) < primitives(node) (Octree-R's surface-area model;
   // it stops where no plane separates the primitives). 0: no cost test.
   double split_cost = 0.0;
+  // References the whole tree may hold per stored primitive (>= 1): nodes
+  // are split breadth first, and a split that would take the total past
+  // the budget is not made (the node stays a leaf). Bounds memory and build
+  // time where depth and leaf size alone do not: surfaces that meet along a
+  // line or at a point (a fan of slivers around one vertex) hold more than
+  // leaf_size primitives in every cell down to the maximum depth.
+  double ref_budget = 16.0;
   // The largest buffer the device can allocate (0: no limit); the build
   // stops with an Error as soon as the references or nodes exceed it.
   std::size_t max_alloc_bytes = 0;
@@ -89,7 +96,8 @@ double scene_magnitude(const Geometry& geometry);
 // subdivides the root box [lower, upper] over the stored primitives of
 // validated geometry. A node becomes a leaf at level max_depth, with at
 // most leaf_size primitives, when no child would hold fewer primitives
-// than it (no progress), or when the split does not pay (split_cost); a primitive is listed in every child whose
+// than it (no progress), when the split does not pay (split_cost), or when
+// it would exceed the reference budget (ref_budget); a primitive is listed in every child whose
 // widened closed box it meets (exact triangle/box and sphere/box tests).
 // `max_depth_limit` is what the structure's addressing can hold.
 OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float, 3>& lower,

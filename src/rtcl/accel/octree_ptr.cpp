@@ -59,6 +59,7 @@ OctreePtr build_octree_ptr(const Geometry& geometry, const OctreePtrConfig& conf
   build.structure = "octree-ptr";
   build.max_depth = config.max_depth;
   build.leaf_size = config.leaf_size;
+  build.ref_budget = config.ref_budget;
   build.max_alloc_bytes = config.max_alloc_bytes;
   check_octree_config(build, kOctreePtrMaxDepth);
   OctreeHeader cube = octree_cube(geometry, config.max_depth);
@@ -143,7 +144,10 @@ const StructureSpec& octree_ptr_structure() {
         "maximum depth (the traversal stack holds 3 entries per level): deeper trees make shorter leaf lists, "
         "more nodes to descend and more references"},
        {"leaf_size", OptionType::integer, std::int64_t(OctreePtrConfig{}.leaf_size), 1, 1 << 20, false,
-        "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"}}};
+        "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"},
+       {"ref_budget", OptionType::real, OctreePtrConfig{}.ref_budget, 1, 1e6, false,
+        "references per primitive the tree may hold: splits past it are not made (bounds memory where "
+        "surfaces meet along a line or at a point)"}}};
   return spec;
 }
 
@@ -153,6 +157,7 @@ std::unique_ptr<Accel> make_octree_ptr_accel(const Device& device, const Geometr
   OctreePtrConfig tree;
   tree.max_depth = static_cast<int>(o.integer("depth"));
   tree.leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
+  tree.ref_budget = o.real("ref_budget");
   return make_octree_ptr(device, geometry, tree, config);
 }
 

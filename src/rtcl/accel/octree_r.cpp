@@ -47,6 +47,7 @@ OctreePtr build_octree_r(const Geometry& geometry, const OctreeRConfig& config) 
   build.structure = "octree-r";
   build.max_depth = config.max_depth;
   build.leaf_size = config.leaf_size;
+  build.ref_budget = config.ref_budget;
   build.max_alloc_bytes = config.max_alloc_bytes;
   build.split_cost = config.traversal_cost;
   check_octree_config(build, kOctreePtrMaxDepth);
@@ -106,6 +107,9 @@ const StructureSpec& octree_r_structure() {
         "maximum depth (the traversal stack holds 3 entries per level)"},
        {"leaf_size", OptionType::integer, std::int64_t(OctreeRConfig{}.leaf_size), 1, 1 << 20, false,
         "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"},
+       {"ref_budget", OptionType::real, OctreeRConfig{}.ref_budget, 1, 1e6, false,
+        "references per primitive the tree may hold: splits past it are not made (bounds memory where "
+        "surfaces meet along a line or at a point)"},
        {"bins", OptionType::integer, std::int64_t(OctreeRConfig{}.bins), 2, 1024, false,
         "candidate split planes per axis and node, plus one: more find cheaper planes at a longer build"},
        {"traversal_cost", OptionType::real, OctreeRConfig{}.traversal_cost, 0, 1000, true,
@@ -120,6 +124,7 @@ std::unique_ptr<Accel> make_octree_r_accel(const Device& device, const Geometry&
   OctreeRConfig tree;
   tree.max_depth = static_cast<int>(o.integer("depth"));
   tree.leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
+  tree.ref_budget = o.real("ref_budget");
   tree.bins = static_cast<int>(o.integer("bins"));
   tree.traversal_cost = o.real("traversal_cost");
   return make_octree_r(device, geometry, tree, config);
