@@ -17,9 +17,9 @@
  * children are not visited; the later children go on a stack (3 entries
  * per level, RTCL_OCTREE_STACK = 3 * depth + 1), the first is descended.
  *
- * Leaves are tested with the shared batched indexed tests (shared/octree.h)
- * and the walk ends once the closest hit lies inside the leaf just
- * gathered: t_best <= its exit distance less a conservative margin, as the
+ * A leaf holds its own blocks of eight primitives, ids ascending, tested
+ * with the block tests brute force runs (the same t, bit for bit); the walk
+ * ends once the closest hit lies inside the leaf: t_best <= its exit distance less a conservative margin, as the
  * grid's cells; the leaves left are all farther along the ray. Primitives
  * are listed in every leaf whose widened box they meet, so a hit within
  * rounding of a split plane is found on either side. */
@@ -32,7 +32,7 @@
 __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* h,
                                                    global const OctreePtrHeader* header,
                                                    global const OctreeNode* nodes, global const uint* leaf_begin,
-                                                   global const int* refs, global const TriangleBlock* triangles,
+                                                   global const TriangleBlock* triangles,
                                                    global const SphereBlock* spheres) {
   const OctreePtrHeader g = *header;
   if (g.root == RTCL_CHILD_EMPTY) return;
@@ -48,7 +48,6 @@ __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* 
   float stack_ta[RTCL_OCTREE_STACK], stack_tb[RTCL_OCTREE_STACK];
   int sp = 0;
   int ref = g.root;
-  OCTREE_BATCHES
   for (;;) {
     if (ref >= 0) {
       const OctreeNode node = nodes[ref];
@@ -94,10 +93,17 @@ __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* 
       if (ref != RTCL_CHILD_EMPTY) continue;
     } else {
       uint leaf = (uint)~ref;
-      OCTREE_GATHER(leaf_begin[leaf], leaf_begin[leaf + 1])
-      if (h->t_best <= tb - fabs(tb) * RTCL_SLAB_WIDEN) OCTREE_FINISH()
+      uint end = leaf_begin[2 * leaf + 2];
+      for (uint b = leaf_begin[2 * leaf]; b < end; ++b)
+        if (intersect_triangles8(triangles + b, s, h) && RTCL_ANY_HIT) return;
+#ifdef RTCL_HAS_SPHERES
+      end = leaf_begin[2 * leaf + 3];
+      for (uint b = leaf_begin[2 * leaf + 1]; b < end; ++b)
+        if (intersect_spheres8(spheres + b, s, h) && RTCL_ANY_HIT) return;
+#endif
+      if (h->t_best <= tb - fabs(tb) * RTCL_SLAB_WIDEN) return;
     }
-    if (sp == 0) OCTREE_FINISH()
+    if (sp == 0) return;
     --sp;
     ref = stack_ref[sp];
     ta = stack_ta[sp];
@@ -107,6 +113,6 @@ __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* 
 
 #define OCTREE_PTR_PARAMS                                                                          \
   global const OctreePtrHeader *header, global const OctreeNode *nodes, global const uint *leaf_begin, \
-      global const int *refs, global const TriangleBlock *triangles, global const SphereBlock *spheres
-#define OCTREE_PTR_ARGS header, nodes, leaf_begin, refs, triangles, spheres
+      global const TriangleBlock *triangles, global const SphereBlock *spheres
+#define OCTREE_PTR_ARGS header, nodes, leaf_begin, triangles, spheres
 RTCL_TRACE_KERNELS(octree_ptr, OCTREE_PTR_PARAMS, OCTREE_PTR_ARGS)

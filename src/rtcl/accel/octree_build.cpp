@@ -188,6 +188,7 @@ OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float,
                 std::uint64_t(out.nodes.size() / 8) * sizeof(OctreeNode));
   }
   out.blocks = in_order_blocks(geometry, ids);
+  out.ids = std::move(ids);
   return out;
 }
 

@@ -70,6 +70,7 @@ struct PrimitiveBounds {
 
 struct OctreeBuild {
   std::vector<OctreeBuildNode> nodes;  // nodes[0] is the root; children after their parents
+  std::vector<std::uint32_t> ids;      // stored_primitives: reference k is triangle ids[k]
   PrimitiveBlocks blocks;              // in_order_blocks: what references index
   std::size_t ref_count = 0;           // references over all leaves
   std::size_t filled_leaves = 0;       // leaves with at least one reference

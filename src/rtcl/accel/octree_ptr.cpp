@@ -9,10 +9,10 @@ namespace rtcl {
 
 std::size_t OctreePtr::bytes() const {
   return sizeof(OctreePtrHeader) + nodes.size() * sizeof(OctreeNode) + leaf_begin.size() * sizeof(rtcl_u32) +
-         refs.size() * sizeof(rtcl_i32) + blocks.bytes();
+         blocks.bytes();
 }
 
-OctreePtr flatten_octree_ptr(OctreeBuild&& tree, const std::array<float, 3>& lower,
+OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const std::array<float, 3>& lower,
                              const std::array<float, 3>& upper) {
   OctreePtr out;
   for (int a = 0; a < 3; ++a) {
@@ -20,24 +20,36 @@ OctreePtr flatten_octree_ptr(OctreeBuild&& tree, const std::array<float, 3>& low
     out.header.upper[a] = upper[a];
   }
   out.header.depth = tree.depth;
-  out.refs.reserve(tree.ref_count);
-  out.leaf_begin.push_back(0);
+  out.ref_count = tree.ref_count;
+  out.leaf_begin = {0, 0};
+  const std::uint32_t triangle_count = static_cast<std::uint32_t>(geometry.triangles.size());
   // Build order (breadth first) keeps parents before children: an inner
   // node's index is its rank among the inner nodes, so one pass numbers them.
   std::vector<rtcl_i32> reference(tree.nodes.size());
   rtcl_i32 inner = 0;
+  std::vector<std::uint32_t> triangles, spheres;
   for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
     OctreeBuildNode& node = tree.nodes[i];
     if (!node.leaf()) {
       reference[i] = inner++;
-    } else if (node.refs.empty()) {
-      reference[i] = RTCL_CHILD_EMPTY;
-    } else {
-      reference[i] = ~static_cast<rtcl_i32>(out.leaf_begin.size() - 1);
-      out.refs.insert(out.refs.end(), node.refs.begin(), node.refs.end());
-      out.leaf_begin.push_back(static_cast<rtcl_u32>(out.refs.size()));
-      std::vector<rtcl_i32>().swap(node.refs);
+      continue;
     }
+    if (node.refs.empty()) {
+      reference[i] = RTCL_CHILD_EMPTY;
+      continue;
+    }
+    reference[i] = ~static_cast<rtcl_i32>(out.leaf_begin.size() / 2 - 1);
+    triangles.clear();
+    spheres.clear();
+    for (rtcl_i32 r : node.refs)  // refs ascend: triangles by id, then spheres by id
+      (r >= 0 ? triangles : spheres).push_back(r >= 0 ? tree.ids[r] : triangle_count + std::uint32_t(~r));
+    for (std::size_t k = 0; k < triangles.size(); k += RTCL_BLOCK_WIDTH)
+      out.blocks.append(geometry, std::span(triangles).subspan(k, std::min<std::size_t>(RTCL_BLOCK_WIDTH, triangles.size() - k)));
+    for (std::size_t k = 0; k < spheres.size(); k += RTCL_BLOCK_WIDTH)
+      out.blocks.append(geometry, std::span(spheres).subspan(k, std::min<std::size_t>(RTCL_BLOCK_WIDTH, spheres.size() - k)));
+    out.leaf_begin.push_back(static_cast<rtcl_u32>(out.blocks.triangles.size()));
+    out.leaf_begin.push_back(static_cast<rtcl_u32>(out.blocks.spheres.size()));
+    std::vector<rtcl_i32>().swap(node.refs);
   }
   out.nodes.resize(static_cast<std::size_t>(inner));
   for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
@@ -49,8 +61,7 @@ OctreePtr flatten_octree_ptr(OctreeBuild&& tree, const std::array<float, 3>& low
     for (int q = 0; q < 8; ++q) n.child[q] = reference[static_cast<std::size_t>(node.child[q])];
   }
   out.header.root = reference[0];
-  out.header.leaf_count = static_cast<rtcl_u32>(out.leaf_begin.size() - 1);
-  out.blocks = std::move(tree.blocks);
+  out.header.leaf_count = static_cast<rtcl_u32>(out.leaf_begin.size() / 2 - 1);
   return out;
 }
 
@@ -65,7 +76,8 @@ OctreePtr build_octree_ptr(const Geometry& geometry, const OctreePtrConfig& conf
   OctreeHeader cube = octree_cube(geometry, config.max_depth);
   std::array<float, 3> lower{cube.lower[0], cube.lower[1], cube.lower[2]}, upper = octree_cube_upper(cube);
   return flatten_octree_ptr(
-      build_octree_nodes(geometry, lower, upper, build, kOctreePtrMaxDepth, octree_centre_rule(cube)), lower, upper);
+      geometry, build_octree_nodes(geometry, lower, upper, build, kOctreePtrMaxDepth, octree_centre_rule(cube)),
+      lower, upper);
 }
 
 namespace {
@@ -90,25 +102,19 @@ class OctreePtrAccel final : public Accel {
                                                   "octree nodes")),
         leaf_begin_(device.upload(tree.leaf_begin.data(), tree.leaf_begin.size() * sizeof(rtcl_u32),
                                   "octree leaf offsets")),
-        refs_(tree.refs.empty() ? device.upload(&kNoRef, sizeof kNoRef, "octree references")
-                                : device.upload(tree.refs.data(), tree.refs.size() * sizeof(rtcl_i32),
-                                                "octree references")),
         primitives_(upload(device, tree.blocks)) {}
 
  private:
   static constexpr OctreeNode kNoNode{};
-  static constexpr rtcl_i32 kNoRef = 0;
-
   void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
     kernel.setArg(first, header_);
     kernel.setArg(first + 1, nodes_);
     kernel.setArg(first + 2, leaf_begin_);
-    kernel.setArg(first + 3, refs_);
-    kernel.setArg(first + 4, primitives_.triangles);
-    kernel.setArg(first + 5, primitives_.spheres);
+    kernel.setArg(first + 3, primitives_.triangles);
+    kernel.setArg(first + 4, primitives_.spheres);
   }
 
-  cl::Buffer header_, nodes_, leaf_begin_, refs_;
+  cl::Buffer header_, nodes_, leaf_begin_;
   DevicePrimitives primitives_;
 };
 

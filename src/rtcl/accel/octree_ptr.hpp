@@ -33,16 +33,21 @@ struct OctreePtrConfig {
 struct OctreePtr {
   OctreePtrHeader header{};
   std::vector<OctreeNode> nodes;    // inner nodes, the root first
-  std::vector<rtcl_u32> leaf_begin; // leaves + 1 offsets into refs
-  std::vector<rtcl_i32> refs;       // grid encoding
-  PrimitiveBlocks blocks;
+  // Per leaf l: its triangle blocks [leaf_begin[2l], leaf_begin[2l + 2])
+  // and sphere blocks [leaf_begin[2l + 1], leaf_begin[2l + 3]); 2 * (leaves
+  // + 1) entries.
+  std::vector<rtcl_u32> leaf_begin;
+  PrimitiveBlocks blocks;           // each leaf's own copies, ids ascending
+  std::size_t ref_count = 0;        // primitive copies over all leaves
   std::size_t bytes() const;
 };
 
 // The device layout of a built tree over the root box [lower, upper]: inner
-// nodes in build order, leaves with primitives numbered in that order,
-// empty leaves RTCL_CHILD_EMPTY.
-OctreePtr flatten_octree_ptr(OctreeBuild&& tree, const std::array<float, 3>& lower,
+// nodes in build order, leaves with primitives numbered in that order, each
+// with its primitives copied into blocks of its own (contiguous float8
+// rows, as BVH leaves: measured faster than gathering shared references,
+// README "Octrees"), empty leaves RTCL_CHILD_EMPTY.
+OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const std::array<float, 3>& lower,
                              const std::array<float, 3>& upper);
 
 // The centre-split octree over the cube (what `octree` builds), as pointers.

@@ -81,8 +81,8 @@ OctreePtr build_octree_r(const Geometry& geometry, const OctreeRConfig& config) 
     }
     return split;
   };
-  return flatten_octree_ptr(build_octree_nodes(geometry, lower, upper, build, kOctreePtrMaxDepth, rule), lower,
-                            upper);
+  return flatten_octree_ptr(geometry, build_octree_nodes(geometry, lower, upper, build, kOctreePtrMaxDepth, rule),
+                            lower, upper);
 }
 
 std::unique_ptr<Accel> make_octree_r(const Device& device, const Geometry& geometry, const OctreeRConfig& config,
