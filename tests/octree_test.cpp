@@ -196,10 +196,17 @@ TEST(OctreeBuild, TableIsSortedBucketedAndListsEveryPrimitive) {
     EXPECT_EQ(tree.header.top_digits > 0, buckets);
     EXPECT_EQ(tree.bucket_begin.size(), (std::size_t(1) << (3 * tree.header.top_digits)) + 1);
     EXPECT_TRUE(std::is_sorted(tree.bucket_begin.begin(), tree.bucket_begin.end()));
-    EXPECT_EQ(tree.leaf_begin.back(), tree.refs.size());
+    ASSERT_EQ(tree.leaf_begin.size(), 2 * tree.codes.size() + 2);
+    EXPECT_EQ(tree.leaf_begin[tree.leaf_begin.size() - 2], tree.blocks.triangles.size());
+    EXPECT_EQ(tree.leaf_begin.back(), tree.blocks.spheres.size());
     std::vector<int> seen(g.primitive_count(), 0);
-    for (rtcl_i32 r : tree.refs) ++seen[r >= 0 ? std::size_t(r) : g.triangles.size() + std::size_t(~r)];
-    EXPECT_EQ(std::count(seen.begin(), seen.end(), 0), 0);
+    std::size_t copies = 0;
+    for (const TriangleBlock& b : tree.blocks.triangles)
+      for (rtcl_i32 p : b.prim) copies += p >= 0 && ++seen[std::size_t(p)] > 0;
+    for (const SphereBlock& b : tree.blocks.spheres)
+      for (rtcl_i32 p : b.prim) copies += p >= 0 && ++seen[std::size_t(p)] > 0;
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 0), 0) << "a primitive in no leaf";
+    EXPECT_EQ(copies, tree.ref_count);
   }
 }
 

@@ -41,9 +41,8 @@
  * average), so that a lookup reads a few codes instead of log2(leaves)
  * (README, "Octrees", measured both ways: option buckets).
  *
- * Hits are gathered into batches of eight across cells and tested with the
- * shared indexed tests (intersect_triangle_refs / intersect_sphere_refs:
- * the same t as brute force, bit for bit), as the grid does. */
+ * A leaf's primitives are its own blocks (octree_test_leaf: brute force's
+ * block tests, the same t bit for bit). */
 #include "shared/octree.h"
 
 /* Lattice plane n on one axis (OctreeHeader contract; the host builds with
@@ -113,8 +112,7 @@ inline float octree_lattice(float p, float lower, float cell, int step) {
 
 __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, global const OctreeHeader* header,
                                                global const ulong* codes, global const uint* leaf_begin,
-                                               global const uint* bucket_begin, global const int* refs,
-                                               global const TriangleBlock* triangles,
+                                               global const uint* bucket_begin, global const TriangleBlock* triangles,
                                                global const SphereBlock* spheres) {
   const OctreeHeader g = *header;
   if (g.leaf_count == 0) return;
@@ -132,11 +130,10 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
     float x = octree_lattice(step[a] == 0 ? o[a] : o[a] + t0 * d[a], g.lower[a], g.cell, step[a]);
     p[a] = (uint)clamp(x, 0.0f, (float)(side - 1));
   }
-  OCTREE_BATCHES
   for (;;) {
     int leaf;
     int level = octree_lookup(octree_point_code(p[0], p[1], p[2]), &g, codes, bucket_begin, &leaf);
-    if (leaf >= 0) OCTREE_GATHER(leaf_begin[leaf], leaf_begin[leaf + 1])
+    if (leaf >= 0 && octree_test_leaf((uint)leaf, leaf_begin, triangles, spheres, s, h)) return;
     /* property 2: the cell's lower corner and side */
     const uint size = 1u << (g.depth - level);
     uint lower[3];
@@ -149,8 +146,8 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
     }
     int axis = (t_exit[0] <= t_exit[1] && t_exit[0] <= t_exit[2]) ? 0 : (t_exit[1] <= t_exit[2] ? 1 : 2);
     float te = t_exit[axis];
-    if (h->t_best <= te - fabs(te) * RTCL_SLAB_WIDEN) OCTREE_FINISH()
-    if (step[axis] == 0) OCTREE_FINISH()
+    if (h->t_best <= te - fabs(te) * RTCL_SLAB_WIDEN) return;
+    if (step[axis] == 0) return;
     /* the next point: one step past the exit face, the others from the exit
      * point, clamped into this cell and monotone */
     for (int a = 0; a < 3; ++a) {
@@ -162,9 +159,9 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
     }
     if (step[axis] > 0) {
       p[axis] = lower[axis] + size;
-      if (p[axis] >= side) OCTREE_FINISH()
+      if (p[axis] >= side) return;
     } else {
-      if (lower[axis] == 0) OCTREE_FINISH()
+      if (lower[axis] == 0) return;
       p[axis] = lower[axis] - 1u;
     }
   }
@@ -172,7 +169,6 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
 
 #define OCTREE_PARAMS                                                                                  \
   global const OctreeHeader *header, global const ulong *codes, global const uint *leaf_begin,         \
-      global const uint *bucket_begin, global const int *refs, global const TriangleBlock *triangles, \
-      global const SphereBlock *spheres
-#define OCTREE_ARGS header, codes, leaf_begin, bucket_begin, refs, triangles, spheres
+      global const uint *bucket_begin, global const TriangleBlock *triangles, global const SphereBlock *spheres
+#define OCTREE_ARGS header, codes, leaf_begin, bucket_begin, triangles, spheres
 RTCL_TRACE_KERNELS(octree, OCTREE_PARAMS, OCTREE_ARGS)

@@ -92,15 +92,7 @@ __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* 
       ref = node.child[first];
       if (ref != RTCL_CHILD_EMPTY) continue;
     } else {
-      uint leaf = (uint)~ref;
-      uint end = leaf_begin[2 * leaf + 2];
-      for (uint b = leaf_begin[2 * leaf]; b < end; ++b)
-        if (intersect_triangles8(triangles + b, s, h) && RTCL_ANY_HIT) return;
-#ifdef RTCL_HAS_SPHERES
-      end = leaf_begin[2 * leaf + 3];
-      for (uint b = leaf_begin[2 * leaf + 1]; b < end; ++b)
-        if (intersect_spheres8(spheres + b, s, h) && RTCL_ANY_HIT) return;
-#endif
+      if (octree_test_leaf((uint)~ref, leaf_begin, triangles, spheres, s, h)) return;
       if (h->t_best <= tb - fabs(tb) * RTCL_SLAB_WIDEN) return;
     }
     if (sp == 0) return;

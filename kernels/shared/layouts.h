@@ -92,9 +92,10 @@ typedef struct GridHeader {
  * the low 4N bits of a 64-bit word; child q of a node holds the points whose
  * lattice coordinate bits at its level give q = i + 2j + 4k (property 1).
  * The leaves that hold primitives are a table sorted by code: codes[0 ..
- * leaf_count) (ulong), their references refs[leaf_begin[l] .. leaf_begin[l +
- * 1]) (the grid's reference encoding: triangles r >= 0, then spheres ~r).
- * Leaves without primitives are not stored. bucket_begin[b], for the b-th
+ * leaf_count) (ulong); leaf l holds its own triangle blocks [leaf_begin[2l],
+ * leaf_begin[2l + 2]) and sphere blocks [leaf_begin[2l + 1], leaf_begin[2l +
+ * 3]), ids ascending (copies: a primitive in several leaves is in a block of
+ * each). Leaves without primitives are not stored. bucket_begin[b], for the b-th
  * prefix of top_digits digits (base 8, b in [0, 8^top_digits)), is the first
  * leaf whose code is not below that prefix followed by digits 0;
  * bucket_begin[8^top_digits] = leaf_count (top_digits 0: one bucket, the
@@ -115,7 +116,7 @@ typedef struct OctreeHeader {
  * upper side of split[0] when q & 1, of split[1] when q & 2, of split[2]
  * when q & 4 (closed boxes). child[q] >= 0 is an inner node index,
  * RTCL_CHILD_EMPTY an empty leaf, any other negative c the leaf ~c, whose
- * references are refs[leaf_begin[~c] .. leaf_begin[~c + 1]) (grid encoding).
+ * blocks are given by leaf_begin pairs as in OctreeHeader.
  * 48 bytes. */
 typedef struct OctreeNode {
   float split[4];        /* x, y, z; [3] unused */

@@ -1,5 +1,5 @@
 /* What the two octree kernels (kernels/accel/octree.cl, octree_ptr.cl)
- * share: the clip of a ray to the root box and the batched leaf tests.
+ * share: the clip of a ray to the root box and the leaf tests.
  * OpenCL C only. */
 #ifndef RTCL_SHARED_OCTREE_H
 #define RTCL_SHARED_OCTREE_H
@@ -23,56 +23,21 @@ inline int octree_clip_axis(float o, float d, float inv, float lower, float uppe
   return 1;
 }
 
-/* The references of one leaf, refs[begin .. end), gathered into batches of
- * eight per kind and tested when a batch is full (the indexed tests of
- * shared/triangle.h and shared/sphere.h: brute force's t, bit for bit).
- * Needs tri_batch, tri_count (and sphere_batch, sphere_count with spheres),
- * s, h, triangles, spheres in scope; returns from the traversal at the
- * first hit of an any-hit query. OCTREE_FINISH() tests what is pending and
- * returns. */
-#define OCTREE_FLUSH_TRIANGLES()                                                        \
-  if (tri_count > 0) {                                                                  \
-    int found = intersect_triangle_refs(triangles, tri_batch, tri_count, s, h);         \
-    tri_count = 0;                                                                      \
-    if (found && RTCL_ANY_HIT) return;                                                  \
-  }
+/* Tests the blocks of leaf `leaf` (OctreeHeader / OctreeNode pair layout:
+ * triangle blocks [leaf_begin[2l], leaf_begin[2l + 2]), sphere blocks
+ * [leaf_begin[2l + 1], leaf_begin[2l + 3])) with the block tests brute force
+ * runs (the same t, bit for bit). Returns 1 when an any-hit query is done. */
+inline int octree_test_leaf(uint leaf, global const uint* leaf_begin, global const TriangleBlock* triangles,
+                            global const SphereBlock* spheres, const TraceRay* s, HitState* h) {
+  uint end = leaf_begin[2 * leaf + 2];
+  for (uint b = leaf_begin[2 * leaf]; b < end; ++b)
+    if (intersect_triangles8(triangles + b, s, h) && RTCL_ANY_HIT) return 1;
 #ifdef RTCL_HAS_SPHERES
-#define OCTREE_FLUSH_SPHERES()                                                          \
-  if (sphere_count > 0) {                                                               \
-    int found = intersect_sphere_refs(spheres, sphere_batch, sphere_count, s, h);       \
-    sphere_count = 0;                                                                   \
-    if (found && RTCL_ANY_HIT) return;                                                  \
-  }
-#define OCTREE_BATCHES  \
-  int tri_batch[8];     \
-  int tri_count = 0;    \
-  int sphere_batch[8];  \
-  int sphere_count = 0;
-#define OCTREE_GATHER_SPHERE(r)                  \
-  if ((r) < 0) {                                 \
-    sphere_batch[sphere_count++] = ~(r);         \
-    if (sphere_count == 8) OCTREE_FLUSH_SPHERES() \
-    continue;                                    \
-  }
-#else
-#define OCTREE_FLUSH_SPHERES()
-#define OCTREE_BATCHES \
-  int tri_batch[8];    \
-  int tri_count = 0;
-#define OCTREE_GATHER_SPHERE(r)
+  end = leaf_begin[2 * leaf + 3];
+  for (uint b = leaf_begin[2 * leaf + 1]; b < end; ++b)
+    if (intersect_spheres8(spheres + b, s, h) && RTCL_ANY_HIT) return 1;
 #endif
-#define OCTREE_FINISH()      \
-  {                          \
-    OCTREE_FLUSH_TRIANGLES() \
-    OCTREE_FLUSH_SPHERES()   \
-    return;                  \
-  }
-#define OCTREE_GATHER(begin, end)                 \
-  for (uint k_ = (begin); k_ < (end); ++k_) {     \
-    int r_ = refs[k_];                            \
-    OCTREE_GATHER_SPHERE(r_)                      \
-    tri_batch[tri_count++] = r_;                  \
-    if (tri_count == 8) OCTREE_FLUSH_TRIANGLES()  \
-  }
+  return 0;
+}
 
 #endif

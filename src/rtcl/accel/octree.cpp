@@ -28,7 +28,7 @@ int bucket_digits(std::size_t leaves, int depth) {
 
 std::size_t Octree::bytes() const {
   return sizeof(OctreeHeader) + codes.size() * sizeof(std::uint64_t) + leaf_begin.size() * sizeof(rtcl_u32) +
-         bucket_begin.size() * sizeof(rtcl_u32) + refs.size() * sizeof(rtcl_i32) + blocks.bytes();
+         bucket_begin.size() * sizeof(rtcl_u32) + blocks.bytes();
 }
 
 OctreeHeader octree_cube(const Geometry& geometry, int depth) {
@@ -116,14 +116,13 @@ Octree build_octree(const Geometry& geometry, const OctreeConfig& config) {
   }
   std::sort(leaves.begin(), leaves.end());
   out.codes.reserve(leaves.size());
-  out.leaf_begin.reserve(leaves.size() + 1);
-  out.refs.reserve(tree.ref_count);
-  out.leaf_begin.push_back(0);
+  out.leaf_begin.reserve(2 * leaves.size() + 2);
+  out.leaf_begin = {0, 0};
+  out.ref_count = tree.ref_count;
   for (const auto& [code, i] : leaves) {
     out.codes.push_back(code);
-    const std::vector<rtcl_i32>& refs = tree.nodes[i].refs;
-    out.refs.insert(out.refs.end(), refs.begin(), refs.end());
-    out.leaf_begin.push_back(static_cast<rtcl_u32>(out.refs.size()));
+    append_leaf_blocks(geometry, tree.ids, tree.nodes[i].refs, out.blocks, out.leaf_begin);
+    std::vector<rtcl_i32>().swap(tree.nodes[i].refs);
   }
   out.header.leaf_count = static_cast<rtcl_u32>(out.codes.size());
 
@@ -147,7 +146,6 @@ Octree build_octree(const Geometry& geometry, const OctreeConfig& config) {
                 std::to_string(out.codes.size() * sizeof(std::uint64_t)) +
                 " bytes, more than the device's largest buffer (" + std::to_string(config.max_alloc_bytes) +
                 " bytes, CL_DEVICE_MAX_MEM_ALLOC_SIZE); use a smaller depth or a larger leaf_size");
-  out.blocks = std::move(tree.blocks);
   return out;
 }
 
@@ -166,26 +164,21 @@ class OctreeAccel final : public Accel {
                                   "octree leaf offsets")),
         bucket_begin_(device.upload(tree.bucket_begin.data(), tree.bucket_begin.size() * sizeof(rtcl_u32),
                                     "octree buckets")),
-        refs_(tree.refs.empty() ? device.upload(&kNoRef, sizeof kNoRef, "octree references")
-                                : device.upload(tree.refs.data(), tree.refs.size() * sizeof(rtcl_i32),
-                                                "octree references")),
         primitives_(upload(device, tree.blocks)) {}
 
  private:
   static constexpr std::uint64_t kNoCode = 0;
-  static constexpr rtcl_i32 kNoRef = 0;
 
   void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
     kernel.setArg(first, header_);
     kernel.setArg(first + 1, codes_);
     kernel.setArg(first + 2, leaf_begin_);
     kernel.setArg(first + 3, bucket_begin_);
-    kernel.setArg(first + 4, refs_);
-    kernel.setArg(first + 5, primitives_.triangles);
-    kernel.setArg(first + 6, primitives_.spheres);
+    kernel.setArg(first + 4, primitives_.triangles);
+    kernel.setArg(first + 5, primitives_.spheres);
   }
 
-  cl::Buffer header_, codes_, leaf_begin_, bucket_begin_, refs_;
+  cl::Buffer header_, codes_, leaf_begin_, bucket_begin_;
   DevicePrimitives primitives_;
 };
 

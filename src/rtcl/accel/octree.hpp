@@ -40,10 +40,10 @@ struct OctreeConfig {
 struct Octree {
   OctreeHeader header{};
   std::vector<std::uint64_t> codes;       // leaves with primitives, ascending
-  std::vector<rtcl_u32> leaf_begin;       // codes.size() + 1 offsets into refs
+  std::vector<rtcl_u32> leaf_begin;       // 2 * (codes.size() + 1) block offsets (OctreeHeader)
   std::vector<rtcl_u32> bucket_begin;     // 8^top_digits + 1 table offsets
-  std::vector<rtcl_i32> refs;             // grid encoding
-  PrimitiveBlocks blocks;                 // in_order_blocks
+  PrimitiveBlocks blocks;                 // each leaf's own blocks (append_leaf_blocks)
+  std::size_t ref_count = 0;              // primitive copies over all leaves
   std::size_t node_count = 0;             // inner nodes and leaves, empty ones too
   std::size_t bytes() const;              // everything the device holds
 };

@@ -96,6 +96,19 @@ double octree_padding(const Geometry& geometry) {
   return std::max(16.0 * FLT_EPSILON * scene_magnitude(geometry), static_cast<double>(FLT_MIN));
 }
 
+void append_leaf_blocks(const Geometry& geometry, const std::vector<std::uint32_t>& ids,
+                        const std::vector<rtcl_i32>& refs, PrimitiveBlocks& blocks,
+                        std::vector<rtcl_u32>& leaf_begin) {
+  const std::uint32_t triangle_count = static_cast<std::uint32_t>(geometry.triangles.size());
+  std::vector<std::uint32_t> triangles, spheres;
+  for (rtcl_i32 r : refs) (r >= 0 ? triangles : spheres).push_back(r >= 0 ? ids[r] : triangle_count + std::uint32_t(~r));
+  for (const std::vector<std::uint32_t>* kind : {&triangles, &spheres})
+    for (std::size_t k = 0; k < kind->size(); k += RTCL_BLOCK_WIDTH)
+      blocks.append(geometry, std::span(*kind).subspan(k, std::min<std::size_t>(RTCL_BLOCK_WIDTH, kind->size() - k)));
+  leaf_begin.push_back(static_cast<rtcl_u32>(blocks.triangles.size()));
+  leaf_begin.push_back(static_cast<rtcl_u32>(blocks.spheres.size()));
+}
+
 void check_octree_config(const OctreeBuildConfig& config, int max_depth_limit) {
   if (config.max_depth < 0 || config.max_depth > max_depth_limit)
     throw Error(config.structure + ": depth=" + std::to_string(config.max_depth) + ": must be in [0, " +

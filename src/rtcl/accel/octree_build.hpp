@@ -105,6 +105,15 @@ OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float,
                                const std::array<float, 3>& upper, const OctreeBuildConfig& config,
                                int max_depth_limit, const OctreeSplitRule& rule);
 
+// Appends the primitives of one leaf (`refs`, ascending: triangles then
+// spheres; `ids` = OctreeBuild::ids) to `blocks` as blocks of its own, eight
+// to a block, ids ascending, and then the new ends of the triangle and
+// sphere block arrays to `leaf_begin` (the pair layout of
+// OctreeHeader / OctreeNode leaves).
+void append_leaf_blocks(const Geometry& geometry, const std::vector<std::uint32_t>& ids,
+                        const std::vector<rtcl_i32>& refs, PrimitiveBlocks& blocks,
+                        std::vector<rtcl_u32>& leaf_begin);
+
 // Checks the common options before any work: depth in [0, max_depth_limit]
 // and leaf_size >= 1, else Error naming the structure and the option.
 void check_octree_config(const OctreeBuildConfig& config, int max_depth_limit);

@@ -22,12 +22,10 @@ OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const
   out.header.depth = tree.depth;
   out.ref_count = tree.ref_count;
   out.leaf_begin = {0, 0};
-  const std::uint32_t triangle_count = static_cast<std::uint32_t>(geometry.triangles.size());
   // Build order (breadth first) keeps parents before children: an inner
   // node's index is its rank among the inner nodes, so one pass numbers them.
   std::vector<rtcl_i32> reference(tree.nodes.size());
   rtcl_i32 inner = 0;
-  std::vector<std::uint32_t> triangles, spheres;
   for (std::size_t i = 0; i < tree.nodes.size(); ++i) {
     OctreeBuildNode& node = tree.nodes[i];
     if (!node.leaf()) {
@@ -39,16 +37,7 @@ OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const
       continue;
     }
     reference[i] = ~static_cast<rtcl_i32>(out.leaf_begin.size() / 2 - 1);
-    triangles.clear();
-    spheres.clear();
-    for (rtcl_i32 r : node.refs)  // refs ascend: triangles by id, then spheres by id
-      (r >= 0 ? triangles : spheres).push_back(r >= 0 ? tree.ids[r] : triangle_count + std::uint32_t(~r));
-    for (std::size_t k = 0; k < triangles.size(); k += RTCL_BLOCK_WIDTH)
-      out.blocks.append(geometry, std::span(triangles).subspan(k, std::min<std::size_t>(RTCL_BLOCK_WIDTH, triangles.size() - k)));
-    for (std::size_t k = 0; k < spheres.size(); k += RTCL_BLOCK_WIDTH)
-      out.blocks.append(geometry, std::span(spheres).subspan(k, std::min<std::size_t>(RTCL_BLOCK_WIDTH, spheres.size() - k)));
-    out.leaf_begin.push_back(static_cast<rtcl_u32>(out.blocks.triangles.size()));
-    out.leaf_begin.push_back(static_cast<rtcl_u32>(out.blocks.spheres.size()));
+    append_leaf_blocks(geometry, tree.ids, node.refs, out.blocks, out.leaf_begin);
     std::vector<rtcl_i32>().swap(node.refs);
   }
   out.nodes.resize(static_cast<std::size_t>(inner));
