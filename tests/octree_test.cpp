@@ -319,15 +319,22 @@ TEST(OctreeTrace, TheDeepestTreesMatchBruteForce) {
 }
 
 TEST(OctreeTrace, DyadicQuadsSeenAlongCellEdges) {
-  // Quads at x = 0.5, 1.5, ... fall on lattice planes of the cube.
+  // Quads across each axis at 0.5, 1.5, 2.5: on lattice planes of the
+  // depth-4 cube over [0, 4]^3 (up to its padding), seen along cell edges.
   std::vector<float> xyz;
   std::vector<std::uint32_t> idx;
-  for (int q = 0; q < 4; ++q) {
-    float x = 0.5f + q;
-    std::uint32_t b = static_cast<std::uint32_t>(xyz.size() / 3);
-    for (float v : {x, 0.0f, 0.0f, x, 4.0f, 0.0f, x, 0.0f, 4.0f, x, 4.0f, 4.0f}) xyz.push_back(v);
-    for (std::uint32_t v : {b, b + 1, b + 2, b + 1, b + 3, b + 2}) idx.push_back(v);
-  }
+  for (int axis = 0; axis < 3; ++axis)
+    for (float at : {0.5f, 1.5f, 2.5f}) {
+      std::uint32_t base = static_cast<std::uint32_t>(xyz.size() / 3);
+      for (int corner = 0; corner < 4; ++corner) {
+        float p[3];
+        p[axis] = at;
+        p[(axis + 1) % 3] = corner & 1 ? 4.0f : 0.0f;
+        p[(axis + 2) % 3] = corner & 2 ? 4.0f : 0.0f;
+        xyz.insert(xyz.end(), p, p + 3);
+      }
+      idx.insert(idx.end(), {base, base + 1, base + 2, base + 1, base + 3, base + 2});
+    }
   Geometry g = Geometry::from_arrays(xyz.data(), xyz.size() / 3, idx.data(), idx.size() / 3, "dyadic quads");
   std::vector<Ray> rays = plane_rays(lattice_planes(g, 4, 4), g, 31, 700);
   for (int y = 0; y <= 4; ++y)

@@ -186,16 +186,9 @@ class OctreeAccel final : public Accel {
 
 std::unique_ptr<Accel> make_octree(const Device& device, const Geometry& geometry, const OctreeConfig& config,
                                    const AccelConfig& accel_config) {
-  auto start = std::chrono::steady_clock::now();
-  GeometryReport report = validate(geometry);
-  OctreeConfig limited = config;
-  if (!limited.max_alloc_bytes) limited.max_alloc_bytes = device.info().max_alloc_bytes;
-  Octree tree = build_octree(geometry, limited);
   AccelStats stats;
-  stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  Octree tree = timed_octree_build(device, geometry, config, build_octree, &stats);
   stats.device_bytes = tree.bytes();
-  stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
-  stats.zero_area_skipped = report.zero_area_triangles;
   stats.node_count = tree.node_count;
   stats.leaf_count = tree.blocks.triangles.size() + tree.blocks.spheres.size();
   return std::make_unique<OctreeAccel>(device, geometry, tree, stats, accel_config);

@@ -25,7 +25,7 @@ struct OctreeConfig {
   // "Octrees".
   int max_depth = 10;
   // Primitives a node may hold and still be a leaf (k >= 1).
-  std::size_t leaf_size = 8;
+  std::size_t leaf_size = 32;
   // References per stored primitive the tree may hold (OctreeBuildConfig).
   double ref_budget = 16.0;
   // Index the table by the first digits of a code (bucket_begin, about one

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -17,6 +18,7 @@
 
 #include <glm/glm.hpp>
 
+#include "rtcl/accel/accel.hpp"
 #include "rtcl/accel/primitive_blocks.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/scene/geometry.hpp"
@@ -117,5 +119,22 @@ void append_leaf_blocks(const Geometry& geometry, const std::vector<std::uint32_
 // Checks the common options before any work: depth in [0, max_depth_limit]
 // and leaf_size >= 1, else Error naming the structure and the option.
 void check_octree_config(const OctreeBuildConfig& config, int max_depth_limit);
+
+// What every octree factory does around its builder: validates geometry,
+// limits config.max_alloc_bytes to the device's largest buffer when unset,
+// runs build(geometry, config) and fills stats->build_ms (validation and
+// build) and the primitive counts.
+template <class Config, class Build>
+auto timed_octree_build(const Device& device, const Geometry& geometry, Config config, const Build& build,
+                        AccelStats* stats) {
+  auto start = std::chrono::steady_clock::now();
+  GeometryReport report = validate(geometry);
+  if (!config.max_alloc_bytes) config.max_alloc_bytes = device.info().max_alloc_bytes;
+  auto tree = build(geometry, config);
+  stats->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats->primitive_count = geometry.primitive_count() - report.zero_area_triangles;
+  stats->zero_area_skipped = report.zero_area_triangles;
+  return tree;
+}
 
 }  // namespace rtcl

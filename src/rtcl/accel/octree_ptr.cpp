@@ -119,15 +119,8 @@ std::unique_ptr<Accel> make_octree_ptr_from(const Device& device, const Geometry
 
 std::unique_ptr<Accel> make_octree_ptr(const Device& device, const Geometry& geometry, const OctreePtrConfig& config,
                                        const AccelConfig& accel_config) {
-  auto start = std::chrono::steady_clock::now();
-  GeometryReport report = validate(geometry);
-  OctreePtrConfig limited = config;
-  if (!limited.max_alloc_bytes) limited.max_alloc_bytes = device.info().max_alloc_bytes;
-  OctreePtr tree = build_octree_ptr(geometry, limited);
   AccelStats stats;
-  stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
-  stats.zero_area_skipped = report.zero_area_triangles;
+  OctreePtr tree = timed_octree_build(device, geometry, config, build_octree_ptr, &stats);
   return make_octree_ptr_from(device, geometry, "octree-ptr", tree, stats, accel_config);
 }
 
