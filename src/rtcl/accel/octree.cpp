@@ -89,12 +89,7 @@ std::array<float, 3> octree_cube_upper(const OctreeHeader& cube) {
 }
 
 Octree build_octree(const Geometry& geometry, const OctreeConfig& config) {
-  OctreeBuildConfig build;
-  build.structure = "octree";
-  build.max_depth = config.max_depth;
-  build.leaf_size = config.leaf_size;
-  build.ref_budget = config.ref_budget;
-  build.max_alloc_bytes = config.max_alloc_bytes;
+  OctreeBuildConfig build = octree_build_config(config, "octree");
   check_octree_config(build, RTCL_OCTREE_MAX_DEPTH);
   Octree out;
   out.header = octree_cube(geometry, config.max_depth);
@@ -198,25 +193,18 @@ const StructureSpec& octree_structure() {
   static const StructureSpec spec{
       "octree",
       "octree of node codes (lecture), traversal by longest code match and cell exit points in lattice coordinates",
-      {{"depth", OptionType::integer, std::int64_t(OctreeConfig{}.max_depth), 0, RTCL_OCTREE_MAX_DEPTH, false,
-        "maximum depth N (lattice 2^N per axis; 16 hexadecimal digits fill the 64-bit code): deeper trees make "
-        "shorter leaf lists, more cells to walk and more references"},
-       {"leaf_size", OptionType::integer, std::int64_t(OctreeConfig{}.leaf_size), 1, 1 << 20, false,
-        "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"},
-       {"ref_budget", OptionType::real, OctreeConfig{}.ref_budget, 1, 1e6, false,
-        "references per primitive the tree may hold: splits past it are not made (bounds memory where "
-        "surfaces meet along a line or at a point)"},
-       {"buckets", OptionType::boolean, OctreeConfig{}.buckets, 0, 0, false,
-        "index the code table by its first digits before the binary search (false: search the whole table)"}}};
+      octree_options(RTCL_OCTREE_MAX_DEPTH, OctreeConfig{}.max_depth, OctreeConfig{}.leaf_size,
+                     OctreeConfig{}.ref_budget,
+                     {{"buckets", OptionType::boolean, OctreeConfig{}.buckets, 0, 0, false,
+                       "index the code table by its first digits before the binary search (false: search the "
+                       "whole table)"}})};
   return spec;
 }
 
 std::unique_ptr<Accel> make_octree_accel(const Device& device, const Geometry& geometry, const AccelConfig& config) {
   AccelOptions o = resolve_options(octree_structure(), config.options, "--accel octree");
   OctreeConfig tree;
-  tree.max_depth = static_cast<int>(o.integer("depth"));
-  tree.leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
-  tree.ref_budget = o.real("ref_budget");
+  read_octree_options(o, &tree);
   tree.buckets = o.boolean("buckets");
   return make_octree(device, geometry, tree, config);
 }

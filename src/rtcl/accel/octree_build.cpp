@@ -109,6 +109,21 @@ void append_leaf_blocks(const Geometry& geometry, const std::vector<std::uint32_
   leaf_begin.push_back(static_cast<rtcl_u32>(blocks.spheres.size()));
 }
 
+std::vector<OptionSpec> octree_options(int max_depth, int depth, std::size_t leaf_size, double ref_budget,
+                                       std::vector<OptionSpec> extra) {
+  std::vector<OptionSpec> out = {
+      {"depth", OptionType::integer, std::int64_t(depth), 0, double(max_depth), false,
+       "maximum depth (levels below the root): deeper trees make shorter leaf lists, more nodes to walk and "
+       "more references"},
+      {"leaf_size", OptionType::integer, std::int64_t(leaf_size), 1, 1 << 20, false,
+       "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"},
+      {"ref_budget", OptionType::real, ref_budget, 1, 1e6, false,
+       "references per primitive the tree may hold: splits past it are not made (bounds memory where surfaces "
+       "meet along a line or at a point)"}};
+  out.insert(out.end(), extra.begin(), extra.end());
+  return out;
+}
+
 void check_octree_config(const OctreeBuildConfig& config, int max_depth_limit) {
   if (config.max_depth < 0 || config.max_depth > max_depth_limit)
     throw Error(config.structure + ": depth=" + std::to_string(config.max_depth) + ": must be in [0, " +

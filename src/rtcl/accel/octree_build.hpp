@@ -116,6 +116,30 @@ void append_leaf_blocks(const Geometry& geometry, const std::vector<std::uint32_
                         const std::vector<rtcl_i32>& refs, PrimitiveBlocks& blocks,
                         std::vector<rtcl_u32>& leaf_begin);
 
+// The options every octree declares (depth, leaf_size, ref_budget), with
+// these defaults and depth range [0, max_depth], then `extra`.
+std::vector<OptionSpec> octree_options(int max_depth, int depth, std::size_t leaf_size, double ref_budget,
+                                       std::vector<OptionSpec> extra = {});
+// Reads them (resolved options) into `config`'s max_depth, leaf_size and
+// ref_budget.
+template <class Config>
+void read_octree_options(const AccelOptions& o, Config* config) {
+  config->max_depth = static_cast<int>(o.integer("depth"));
+  config->leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
+  config->ref_budget = o.real("ref_budget");
+}
+// The common part of a structure's config, for build_octree_nodes.
+template <class Config>
+OctreeBuildConfig octree_build_config(const Config& config, std::string structure) {
+  OctreeBuildConfig build;
+  build.structure = std::move(structure);
+  build.max_depth = config.max_depth;
+  build.leaf_size = config.leaf_size;
+  build.ref_budget = config.ref_budget;
+  build.max_alloc_bytes = config.max_alloc_bytes;
+  return build;
+}
+
 // Checks the common options before any work: depth in [0, max_depth_limit]
 // and leaf_size >= 1, else Error naming the structure and the option.
 void check_octree_config(const OctreeBuildConfig& config, int max_depth_limit);

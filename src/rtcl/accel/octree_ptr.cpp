@@ -55,12 +55,7 @@ OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const
 }
 
 OctreePtr build_octree_ptr(const Geometry& geometry, const OctreePtrConfig& config) {
-  OctreeBuildConfig build;
-  build.structure = "octree-ptr";
-  build.max_depth = config.max_depth;
-  build.leaf_size = config.leaf_size;
-  build.ref_budget = config.ref_budget;
-  build.max_alloc_bytes = config.max_alloc_bytes;
+  OctreeBuildConfig build = octree_build_config(config, "octree-ptr");
   check_octree_config(build, kOctreePtrMaxDepth);
   OctreeHeader cube = octree_cube(geometry, config.max_depth);
   std::array<float, 3> lower{cube.lower[0], cube.lower[1], cube.lower[2]}, upper = octree_cube_upper(cube);
@@ -128,14 +123,8 @@ const StructureSpec& octree_ptr_structure() {
   static const StructureSpec spec{
       "octree-ptr",
       "octree with child pointers (the octree's tree), top-down traversal in ray order (Revelles et al. 2000)",
-      {{"depth", OptionType::integer, std::int64_t(OctreePtrConfig{}.max_depth), 0, kOctreePtrMaxDepth, false,
-        "maximum depth (the traversal stack holds 3 entries per level): deeper trees make shorter leaf lists, "
-        "more nodes to descend and more references"},
-       {"leaf_size", OptionType::integer, std::int64_t(OctreePtrConfig{}.leaf_size), 1, 1 << 20, false,
-        "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"},
-       {"ref_budget", OptionType::real, OctreePtrConfig{}.ref_budget, 1, 1e6, false,
-        "references per primitive the tree may hold: splits past it are not made (bounds memory where "
-        "surfaces meet along a line or at a point)"}}};
+      octree_options(kOctreePtrMaxDepth, OctreePtrConfig{}.max_depth, OctreePtrConfig{}.leaf_size,
+                     OctreePtrConfig{}.ref_budget)};
   return spec;
 }
 
@@ -143,9 +132,7 @@ std::unique_ptr<Accel> make_octree_ptr_accel(const Device& device, const Geometr
                                              const AccelConfig& config) {
   AccelOptions o = resolve_options(octree_ptr_structure(), config.options, "--accel octree-ptr");
   OctreePtrConfig tree;
-  tree.max_depth = static_cast<int>(o.integer("depth"));
-  tree.leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
-  tree.ref_budget = o.real("ref_budget");
+  read_octree_options(o, &tree);
   return make_octree_ptr(device, geometry, tree, config);
 }
 

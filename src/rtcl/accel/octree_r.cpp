@@ -43,12 +43,7 @@ float octree_r_split(double lo, double hi, double e1, double e2, const std::vect
 }
 
 OctreePtr build_octree_r(const Geometry& geometry, const OctreeRConfig& config) {
-  OctreeBuildConfig build;
-  build.structure = "octree-r";
-  build.max_depth = config.max_depth;
-  build.leaf_size = config.leaf_size;
-  build.ref_budget = config.ref_budget;
-  build.max_alloc_bytes = config.max_alloc_bytes;
+  OctreeBuildConfig build = octree_build_config(config, "octree-r");
   build.split_cost = config.traversal_cost;
   check_octree_config(build, kOctreePtrMaxDepth);
   if (!(config.traversal_cost > 0.0) || !std::isfinite(config.traversal_cost))
@@ -96,18 +91,13 @@ const StructureSpec& octree_r_structure() {
   static const StructureSpec spec{
       "octree-r",
       "Octree-R (Whang et al. 1995): split planes per axis chosen by area x count cost, pointer traversal",
-      {{"depth", OptionType::integer, std::int64_t(OctreeRConfig{}.max_depth), 0, kOctreePtrMaxDepth, false,
-        "maximum depth (the traversal stack holds 3 entries per level)"},
-       {"leaf_size", OptionType::integer, std::int64_t(OctreeRConfig{}.leaf_size), 1, 1 << 20, false,
-        "k: a node with at most k primitives is a leaf; smaller k makes more, smaller leaves"},
-       {"ref_budget", OptionType::real, OctreeRConfig{}.ref_budget, 1, 1e6, false,
-        "references per primitive the tree may hold: splits past it are not made (bounds memory where "
-        "surfaces meet along a line or at a point)"},
-       {"bins", OptionType::integer, std::int64_t(OctreeRConfig{}.bins), 2, 1024, false,
-        "candidate split planes per axis and node, plus one: more find cheaper planes at a longer build"},
-       {"traversal_cost", OptionType::real, OctreeRConfig{}.traversal_cost, 0, 1000, true,
-        "cost of a traversal step in primitive tests: a node is split only when that lowers its estimated cost; "
-        "higher makes shallower trees with longer leaves"}}};
+      octree_options(
+          kOctreePtrMaxDepth, OctreeRConfig{}.max_depth, OctreeRConfig{}.leaf_size, OctreeRConfig{}.ref_budget,
+          {{"bins", OptionType::integer, std::int64_t(OctreeRConfig{}.bins), 2, 1024, false,
+            "candidate split planes per axis and node, plus one: more find cheaper planes at a longer build"},
+           {"traversal_cost", OptionType::real, OctreeRConfig{}.traversal_cost, 0, 1000, true,
+            "cost of a traversal step in primitive tests: a node is split only when that lowers its estimated "
+            "cost; higher makes shallower trees with longer leaves"}})};
   return spec;
 }
 
@@ -115,9 +105,7 @@ std::unique_ptr<Accel> make_octree_r_accel(const Device& device, const Geometry&
                                            const AccelConfig& config) {
   AccelOptions o = resolve_options(octree_r_structure(), config.options, "--accel octree-r");
   OctreeRConfig tree;
-  tree.max_depth = static_cast<int>(o.integer("depth"));
-  tree.leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
-  tree.ref_budget = o.real("ref_budget");
+  read_octree_options(o, &tree);
   tree.bins = static_cast<int>(o.integer("bins"));
   tree.traversal_cost = o.real("traversal_cost");
   return make_octree_r(device, geometry, tree, config);
