@@ -24,13 +24,14 @@ struct OctreeConfig {
   // (16 hexadecimal digits fill the 64-bit code). Measured defaults: README
   // "Octrees".
   int max_depth = 10;
-  // Primitives a node may hold and still be a leaf (k >= 1).
+  // Primitives a node may hold and still be a leaf (k >= 1). 32: 0.27x the
+  // BVH on the bunny's primary rays against 0.21x at 8 (README "Octrees").
   std::size_t leaf_size = 32;
   // References per stored primitive the tree may hold (OctreeBuildConfig).
   double ref_budget = 16.0;
   // Index the table by the first digits of a code (bucket_begin, about one
-  // bucket per leaf) before the binary search; false: binary search over
-  // the whole table.
+  // bucket per two leaves) before the binary search; false: binary search
+  // over the whole table (measured 1.39x slower on the bunny).
   bool buckets = true;
   // The largest buffer the device can allocate (0: no limit).
   std::size_t max_alloc_bytes = 0;

@@ -21,7 +21,7 @@ namespace rtcl {
 
 struct OctreeRConfig {
   int max_depth = 10;            // 0 .. kOctreePtrMaxDepth
-  std::size_t leaf_size = 32;    // k >= 1
+  std::size_t leaf_size = 32;    // k >= 1, as octree-ptr's
   // References per stored primitive the tree may hold (OctreeBuildConfig).
   double ref_budget = 16.0;
   // Candidate planes per axis and node: `bins` - 1 planes evenly spaced
