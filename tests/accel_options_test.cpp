@@ -87,7 +87,7 @@ TEST(AccelOptions, BadOptionsNameTheStructureAndTheOption) {
   EXPECT_NE(error_of_spec("grid:lambda=1,lambda=2").find("lambda given twice"), std::string::npos);
   EXPECT_NE(error_of_spec("grid:").find("expected key=value"), std::string::npos);
   EXPECT_NE(error_of_spec("grid:lambda").find("expected key=value"), std::string::npos);
-  EXPECT_NE(error_of_spec("octree:depth=3").find("--accel octree: unknown acceleration structure"), std::string::npos);
+  EXPECT_NE(error_of_spec("quadtree:depth=3").find("--accel quadtree: unknown acceleration structure"), std::string::npos);
   // Typed values from the API are checked the same way.
   EXPECT_THROW(resolve_options(structure_spec("grid"), AccelOptions().set("lambda", true), "grid"), Error);
   EXPECT_THROW(resolve_options(structure_spec("grid"), AccelOptions().set("lambda", -2.0), "grid"), Error);

@@ -36,6 +36,19 @@ RTCL_PROBE_FIELD(GridHeader, res[2]) RTCL_PROBE_FIELD(GridHeader, macro)
 RTCL_PROBE_FIELD(GridHeader, macro[3]) RTCL_PROBE_FIELD(GridHeader, lane_stride)
 RTCL_PROBE_FIELD(GridHeader, occupied_bounds) RTCL_PROBE_FIELD(GridHeader, occupied_bounds[5][7])
 
+RTCL_PROBE_RECORD(OctreeHeader)
+RTCL_PROBE_FIELD(OctreeHeader, lower) RTCL_PROBE_FIELD(OctreeHeader, cell) RTCL_PROBE_FIELD(OctreeHeader, depth)
+RTCL_PROBE_FIELD(OctreeHeader, leaf_count) RTCL_PROBE_FIELD(OctreeHeader, top_digits)
+
+RTCL_PROBE_RECORD(OctreeNode)
+RTCL_PROBE_FIELD(OctreeNode, split) RTCL_PROBE_FIELD(OctreeNode, child) RTCL_PROBE_FIELD(OctreeNode, child[7])
+
+RTCL_PROBE_RECORD(OctreePtrHeader)
+RTCL_PROBE_FIELD(OctreePtrHeader, lower) RTCL_PROBE_FIELD(OctreePtrHeader, upper)
+RTCL_PROBE_FIELD(OctreePtrHeader, root) RTCL_PROBE_FIELD(OctreePtrHeader, leaf_count)
+RTCL_PROBE_FIELD(OctreePtrHeader, depth) RTCL_PROBE_FIELD(OctreePtrHeader, pad)
+
+RTCL_PROBE_VALUE(RTCL_OCTREE_MAX_DEPTH)
 RTCL_PROBE_VALUE(RTCL_BLOCK_WIDTH)
 RTCL_PROBE_VALUE(RTCL_CHILD_EMPTY)
 RTCL_PROBE_VALUE(RTCL_LEAF_TRIANGLES(5))

@@ -104,6 +104,57 @@ typedef struct GridHeader {
   rtcl_i32 unused[3];
 } GridHeader;
 
+/* An octree addressed by node codes (kernels/accel/octree.cl; lecture,
+ * 空间八叉树剖分技术): a cube split at its centre down to at most `depth`
+ * (N <= 16) levels, over the integer lattice 0 .. 2^N per axis. Lattice
+ * plane n on axis a lies at lower[a] + (float)n * cell, computed so by host
+ * and kernel alike. The code of a node at level i is the digits q1 .. qi
+ * followed by N - i digits F, one hexadecimal digit each, q1 the highest of
+ * the low 4N bits of a 64-bit word; child q of a node holds the points whose
+ * lattice coordinate bits at its level give q = i + 2j + 4k (property 1).
+ * The leaves that hold primitives are a table sorted by code: codes[0 ..
+ * leaf_count) (ulong); leaf l holds its own triangle blocks [leaf_begin[2l],
+ * leaf_begin[2l + 2]) and sphere blocks [leaf_begin[2l + 1], leaf_begin[2l +
+ * 3]), ids ascending (copies: a primitive in several leaves is in a block of
+ * each). Leaves without primitives are not stored. bucket_begin[b], for the b-th
+ * prefix of top_digits digits (base 8, b in [0, 8^top_digits)), is the first
+ * leaf whose code is not below that prefix followed by digits 0;
+ * bucket_begin[8^top_digits] = leaf_count (top_digits 0: one bucket, the
+ * whole table). 32 bytes. */
+typedef struct OctreeHeader {
+  float lower[4];        /* [3] unused */
+  float cell;            /* lattice unit, > 0, the same on every axis (a cube) */
+  rtcl_i32 depth;        /* N, 0 .. RTCL_OCTREE_MAX_DEPTH */
+  rtcl_u32 leaf_count;
+  rtcl_i32 top_digits;   /* digits indexing bucket_begin, 0 .. min(N, 7) */
+} OctreeHeader;
+
+/* The deepest code octree a 64-bit code holds: 16 digits of 4 bits. */
+#define RTCL_OCTREE_MAX_DEPTH 16
+
+/* A node of a pointer octree (kernels/accel/octree_ptr.cl; octree-ptr and
+ * octree-r): three split planes and eight children, child q covering the
+ * upper side of split[0] when q & 1, of split[1] when q & 2, of split[2]
+ * when q & 4 (closed boxes). child[q] >= 0 is an inner node index,
+ * RTCL_CHILD_EMPTY an empty leaf, any other negative c the leaf ~c, whose
+ * blocks are given by leaf_begin pairs as in OctreeHeader.
+ * 48 bytes. */
+typedef struct OctreeNode {
+  float split[4];        /* x, y, z; [3] unused */
+  rtcl_i32 child[8];
+} OctreeNode;
+
+/* The root of a pointer octree: its box, and the root reference (an inner
+ * node index, or a leaf or empty reference as in OctreeNode). 48 bytes. */
+typedef struct OctreePtrHeader {
+  float lower[4];        /* [3] unused */
+  float upper[4];        /* [3] unused */
+  rtcl_i32 root;
+  rtcl_u32 leaf_count;
+  rtcl_i32 depth;        /* levels below the root */
+  rtcl_i32 pad;
+} OctreePtrHeader;
+
 #ifndef __OPENCL_VERSION__
 } /* namespace rtcl */
 #endif

@@ -19,5 +19,8 @@ static_assert(sizeof(GridHeader) == 272 && offsetof(GridHeader, occupied_bounds)
               offsetof(GridHeader, lower) == 192 && offsetof(GridHeader, cell) == 208 &&
               offsetof(GridHeader, res) == 224 && offsetof(GridHeader, macro) == 240 &&
               offsetof(GridHeader, lane_stride) == 256);
+static_assert(sizeof(OctreeHeader) == 32 && offsetof(OctreeHeader, cell) == 16 && offsetof(OctreeHeader, top_digits) == 28);
+static_assert(sizeof(OctreeNode) == 48 && offsetof(OctreeNode, child) == 16);
+static_assert(sizeof(OctreePtrHeader) == 48 && offsetof(OctreePtrHeader, root) == 32);
 
 }  // namespace rtcl

@@ -7,6 +7,9 @@
 #include "rtcl/accel/brute.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/grid.hpp"
+#include "rtcl/accel/octree.hpp"
+#include "rtcl/accel/octree_ptr.hpp"
+#include "rtcl/accel/octree_r.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {
@@ -27,6 +30,9 @@ const std::vector<Entry>& registry() {
       {bvh_ploc_structure(), make_bvh_ploc},
       {bvh_packet_structure(), make_bvh_packet},
       {grid_structure(), make_grid_accel},
+      {octree_structure(), make_octree_accel},
+      {octree_ptr_structure(), make_octree_ptr_accel},
+      {octree_r_structure(), make_octree_r_accel},
   };
   return entries;
 }
