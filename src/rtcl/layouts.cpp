@@ -16,5 +16,7 @@ static_assert(sizeof(SphereBlock) == 160 && offsetof(SphereBlock, r) == 96 && of
 static_assert(sizeof(Bvh8Node) == 224 && offsetof(Bvh8Node, child) == 192);
 static_assert(sizeof(Bvh8Node) % 32 == 0, "nodes must start on float8 boundaries");
 static_assert(sizeof(GridHeader) == 48 && offsetof(GridHeader, cell) == 16 && offsetof(GridHeader, res) == 32);
+static_assert(sizeof(KdNode) == 8 && offsetof(KdNode, data) == 4);
+static_assert(sizeof(KdHeader) == 32 && offsetof(KdHeader, upper) == 16);
 
 }  // namespace rtcl

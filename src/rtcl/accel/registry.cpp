@@ -5,8 +5,10 @@
 
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/accel/brute.hpp"
+#include "rtcl/accel/bsp.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/grid.hpp"
+#include "rtcl/accel/kdtree.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {
@@ -27,6 +29,8 @@ const std::vector<Entry>& registry() {
       {bvh_ploc_structure(), make_bvh_ploc},
       {bvh_packet_structure(), make_bvh_packet},
       {grid_structure(), make_grid_accel},
+      {bsp_structure(), make_bsp_accel},
+      {kdtree_structure(), make_kdtree_accel},
   };
   return entries;
 }
