@@ -20,8 +20,8 @@
  *   - an origin on the plane (o == split): near is the side the ray comes
  *     from (below when d > 0), so dist = 0 sends t > 0 to the far side;
  *   - a ray lying in the plane (o == split and d == 0, dist = 0 * inf =
- *     NaN): both children, each over the whole interval (primitives that
- *     touch the plane are listed on both sides, so either would do);
+ *     NaN): both children, each over the whole interval (a primitive that
+ *     touches the plane from one side may be listed on that side only);
  *   - dist exactly at min or max: both children (one of them over an empty
  *     or one-point interval).
  * The comparisons are conservative: the plane counts as inside the interval
@@ -35,9 +35,12 @@
  * candidate even when it lies beyond the leaf's interval (a primitive
  * extending into later leaves is then not closer when met again). Early
  * exit: once the candidate lies inside the current interval, t_best <= max
- * less a conservative margin (a hit within rounding of max continues to
- * the next leaf), nothing nearer remains, since every leaf the ray crosses
- * before max has been visited. Any hit ends at the first hit.
+ * less a conservative margin, nothing nearer remains, since every leaf the
+ * ray crosses before max has been visited. The margin, KD_EXIT_MARGIN
+ * relative, covers the rounding of max and of the hit's t: a primitive
+ * ending exactly on a plane is listed on its side only, and one beyond the
+ * plane hit within rounding of max is still found in the next leaf. Any
+ * hit ends at the first hit.
  *
  * Stack bound (RTCL_KD_STACK, compile-time): an entry is pushed only at an
  * inner node that sends the ray to both children, and holds that node's far
@@ -65,6 +68,8 @@ inline int kd_clip_axis(float o, float d, float inv, float lower, float upper, f
   *t1 = fmin(*t1, tf + fabs(tf) * RTCL_SLAB_WIDEN);
   return 1;
 }
+
+#define KD_EXIT_MARGIN (4.0f * RTCL_SLAB_WIDEN)
 
 #define KD_FLUSH_TRIANGLES()                                                      \
   if (tri_count > 0) {                                                            \
@@ -150,7 +155,7 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
     }
     KD_FLUSH_TRIANGLES()
     KD_FLUSH_SPHERES()
-    if (top == 0 || h->t_best <= t_max - fabs(t_max) * RTCL_SLAB_WIDEN) return;
+    if (top == 0 || h->t_best <= t_max - fabs(t_max) * KD_EXIT_MARGIN) return;
     --top;
     n = stack_node[top];
     t_min = stack_min[top];

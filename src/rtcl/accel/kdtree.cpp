@@ -85,12 +85,19 @@ class KdBuilder {
     const float p = split.pos;
     node->axis = k;
     node->split = p;
-    // Sides: below when the bounds start at or below p, above when they end
-    // at or above it, both within the widening of the plane.
-    const double w = prims_.widen;
+    // Sides, as the sweep counted them: below when the bounds start before
+    // p, above when they end after it, both for bounds flat on p. Bounds
+    // ending exactly at p are below only (event positions are rounded
+    // outwards, so the primitive does not reach beyond p), starting at p
+    // above only. Widening here would list a primitive ending at p as a
+    // sliver on the far side, which the SAH cuts around again and again.
     for (const Event& e : events[k]) {
-      if (e.type != kEnd && e.pos <= p + w) side[e.prim] |= kBelow;
-      if (e.type != kStart && e.pos >= p - w) side[e.prim] |= kAbove;
+      if (e.type == kPlanar && e.pos == p) {
+        side[e.prim] = kBoth;
+        continue;
+      }
+      if (e.type != kEnd && e.pos < p) side[e.prim] |= kBelow;
+      if (e.type != kStart && e.pos > p) side[e.prim] |= kAbove;
     }
     glm::dvec3 below_upper = upper, above_lower = lower;
     below_upper[k] = p;
