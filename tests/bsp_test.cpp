@@ -137,7 +137,9 @@ TEST(BspTrace, CoincidentPrimitivesAtTheMaximumDepth) {
     glm::vec3 d = target - o;
     rays.push_back({o.x, o.y, o.z, d.x, d.y, d.z, 0.0f, INFINITY});
   }
-  for (Precision level : test_precisions())
+  // The stack does not depend on the level; exact also breaks the ties of
+  // the coincident triangles by id.
+  for (Precision level : {Precision::robust, Precision::exact})
     expect_same_as_brute(*make_bsp(test_device(), g, deepest, AccelConfig{level, {}}), g, rays, level);
 }
 

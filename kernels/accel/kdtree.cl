@@ -97,9 +97,6 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
   if (!kd_clip_axis(s->oy, s->dy, s->iy, header->lower[1], header->upper[1], &t_min, &t_max)) return;
   if (!kd_clip_axis(s->oz, s->dz, s->iz, header->lower[2], header->upper[2], &t_min, &t_max)) return;
   if (!(t_min <= t_max)) return;
-  const float o[3] = {s->ox, s->oy, s->oz};
-  const float d[3] = {s->dx, s->dy, s->dz};
-  const float inv[3] = {s->ix, s->iy, s->iz};
   uint stack_node[RTCL_KD_STACK];
   float stack_min[RTCL_KD_STACK], stack_max[RTCL_KD_STACK];
   int top = 0;
@@ -114,10 +111,13 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
     KdNode node = nodes[n];
     uint axis = node.flags & 3u;
     while (axis != RTCL_KD_LEAF) {
-      float delta = as_float(node.data) - o[axis];
-      float dist = delta * inv[axis];
+      float o = axis == 0 ? s->ox : (axis == 1 ? s->oy : s->oz);
+      float d = axis == 0 ? s->dx : (axis == 1 ? s->dy : s->dz);
+      float inv = axis == 0 ? s->ix : (axis == 1 ? s->iy : s->iz);
+      float delta = as_float(node.data) - o;
+      float dist = delta * inv;
       uint below = n + 1, above = node.flags >> 2;
-      int below_near = delta > 0.0f || (delta == 0.0f && d[axis] > 0.0f);
+      int below_near = delta > 0.0f || (delta == 0.0f && d > 0.0f);
       uint near = below_near ? below : above, far = below_near ? above : below;
       if (rtcl_is_nan(dist)) { /* in the plane */
         stack_node[top] = far;
