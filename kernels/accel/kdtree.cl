@@ -34,13 +34,16 @@
  * force, so the same t bit for bit). The closest hit so far stays a
  * candidate even when it lies beyond the leaf's interval (a primitive
  * extending into later leaves is then not closer when met again). Early
- * exit: once the candidate lies inside the current interval, t_best <= max
- * less a conservative margin, nothing nearer remains, since every leaf the
- * ray crosses before max has been visited. The margin, KD_EXIT_MARGIN
- * relative, covers the rounding of max and of the hit's t: a primitive
- * ending exactly on a plane is listed on its side only, and one beyond the
- * plane hit within rounding of max is still found in the next leaf. Any
- * hit ends at the first hit.
+ * exit: a subtree on the stack is skipped when the candidate lies before
+ * its interval, t_best <= its min less a conservative margin; the walk ends
+ * when no subtree is left. A far child's min is the plane's dist, which is
+ * the max of the near side's interval, so this is the lecture's exit once
+ * the hit lies inside the current interval; a ray lying in a plane pushes
+ * its far child over the same interval as the near one, and that subtree
+ * is still visited. The margin, KD_EXIT_MARGIN relative, covers the
+ * rounding of dist and of the hit's t: a primitive ending exactly on a
+ * plane is listed on its side only, and one beyond the plane hit within
+ * rounding of dist is still found. Any hit ends at the first hit.
  *
  * Stack bound (RTCL_KD_STACK, compile-time): an entry is pushed only at an
  * inner node that sends the ray to both children, and holds that node's far
@@ -155,10 +158,13 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
     }
     KD_FLUSH_TRIANGLES()
     KD_FLUSH_SPHERES()
-    if (top == 0 || h->t_best <= t_max - fabs(t_max) * KD_EXIT_MARGIN) return;
-    --top;
+    /* The next subtree whose interval may still hold a nearer hit. */
+    do {
+      if (top == 0) return;
+      --top;
+      t_min = stack_min[top];
+    } while (h->t_best <= t_min - fabs(t_min) * KD_EXIT_MARGIN);
     n = stack_node[top];
-    t_min = stack_min[top];
     t_max = stack_max[top];
   }
 }

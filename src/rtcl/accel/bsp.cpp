@@ -20,8 +20,9 @@ class BspBuilder {
       : prims_(prims), max_depth_(depth), leaf_size_(static_cast<std::size_t>(leaf_size)),
         threads_(static_cast<int>(threads) - 1) {}
 
+  // `budget`: the references this subtree may list (kKdReferenceBudget).
   std::unique_ptr<KdBuildNode> build(glm::dvec3 lower, glm::dvec3 upper, std::vector<std::uint32_t> ids,
-                                     int depth) {
+                                     int depth, double budget) {
     auto node = std::make_unique<KdBuildNode>();
     int axis = depth % 3;
     // The midpoint as a float; a node too thin to split in float is a leaf.
@@ -30,8 +31,6 @@ class BspBuilder {
       node->prims = std::move(ids);
       return node;
     }
-    node->axis = axis;
-    node->split = split;
     glm::dvec3 below_upper = upper, above_lower = lower;
     below_upper[axis] = split;
     above_lower[axis] = split;
@@ -41,15 +40,28 @@ class BspBuilder {
       if (prims_.clip(i, lower, below_upper, &cl, &cu)) below.push_back(i);
       if (prims_.clip(i, above_lower, upper, &cl, &cu)) above.push_back(i);
     }
+    // A leaf as well: a split that leaves every primitive on both sides
+    // (a scene flat in the plane, primitives sharing a point on it), which
+    // only doubles the lists, and one beyond the subtree's budget.
+    double both = static_cast<double>(below.size() + above.size());
+    if ((below.size() == ids.size() && above.size() == ids.size()) || both > budget) {
+      node->prims = std::move(ids);
+      return node;
+    }
+    node->axis = axis;
+    node->split = split;
     ids = {};
-    if (below.size() + above.size() >= kParallelMin && threads_.try_take()) {
-      std::thread worker([&] { node->below = build(lower, below_upper, std::move(below), depth + 1); });
-      node->above = build(above_lower, upper, std::move(above), depth + 1);
+    double below_budget = budget * static_cast<double>(below.size()) / both;
+    double above_budget = budget * static_cast<double>(above.size()) / both;
+    if (both >= kParallelMin && threads_.try_take()) {
+      std::thread worker(
+          [&] { node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget); });
+      node->above = build(above_lower, upper, std::move(above), depth + 1, above_budget);
       worker.join();
       threads_.give_back();
     } else {
-      node->below = build(lower, below_upper, std::move(below), depth + 1);
-      node->above = build(above_lower, upper, std::move(above), depth + 1);
+      node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget);
+      node->above = build(above_lower, upper, std::move(above), depth + 1, above_budget);
     }
     return node;
   }
@@ -80,7 +92,8 @@ KdTree build_bsp(const Geometry& geometry, const BspConfig& config) {
   BspBuilder builder(prims, depth, config.leaf_size, threads);
   std::vector<std::uint32_t> all(prims.size());
   for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
-  auto root = builder.build(prims.lower, prims.upper, std::move(all), 0);
+  auto root = builder.build(prims.lower, prims.upper, std::move(all), 0,
+                            kKdReferenceBudget * static_cast<double>(prims.size()));
   return flatten_kd_tree(prims, *root, "bsp",
                          "depth=" + std::to_string(depth) + ",leaf=" + std::to_string(config.leaf_size),
                          config.max_alloc_bytes);

@@ -58,6 +58,7 @@ struct Split {
   int axis = -1;
   float pos = 0.0f;
   double cost = 0.0;
+  std::size_t n_below = 0, n_above = 0;  // primitives each side lists
 };
 
 // Primitive sides during one split (bit 0: below, bit 1: above).
@@ -68,21 +69,28 @@ class KdBuilder {
   KdBuilder(const KdPrimitives& prims, const KdTreeConfig& config, int depth, unsigned threads)
       : prims_(prims), config_(config), max_depth_(depth), threads_(static_cast<int>(threads) - 1) {}
 
+  // `budget`: the references this subtree may list (kKdReferenceBudget).
   std::unique_ptr<KdBuildNode> build(const glm::dvec3& lower, const glm::dvec3& upper, Events events, int depth,
-                                     std::vector<std::uint8_t>& side) {
+                                     double budget, std::vector<std::uint8_t>& side) {
     auto node = std::make_unique<KdBuildNode>();
     std::size_t n = 0;
     for (const Event& e : events[0]) n += e.type != kEnd;
     Split split;
     if (depth < max_depth_ && n > 0) split = find_split(lower, upper, events, n);
-    if (split.axis < 0) {
+    const int k = split.axis;
+    const float p = split.pos;
+    std::size_t n_below = 0, n_above = 0;
+    if (k >= 0) {
+      n_below = split.n_below;
+      n_above = split.n_above;
+    }
+    double both = static_cast<double>(n_below + n_above);
+    if (k < 0 || both > budget) {
       for (const Event& e : events[0])
         if (e.type != kEnd) node->prims.push_back(e.prim);
       std::sort(node->prims.begin(), node->prims.end());
       return node;
     }
-    const int k = split.axis;
-    const float p = split.pos;
     node->axis = k;
     node->split = p;
     // Sides, as the sweep counted them: below when the bounds start before
@@ -129,17 +137,21 @@ class KdBuilder {
     }
     below_new = {};
     above_new = {};
+    // The children's shares of the budget, from the sweep's counts (an
+    // upper bound of what the clipping keeps).
+    double below_budget = budget * static_cast<double>(n_below) / both;
+    double above_budget = budget * static_cast<double>(n_above) / both;
     if (n >= kParallelMin && threads_.try_take()) {
       std::thread worker([&] {
         std::vector<std::uint8_t> own(prims_.size(), 0);
-        node->below = build(lower, below_upper, std::move(below), depth + 1, own);
+        node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget, own);
       });
-      node->above = build(above_lower, upper, std::move(above), depth + 1, side);
+      node->above = build(above_lower, upper, std::move(above), depth + 1, above_budget, side);
       worker.join();
       threads_.give_back();
     } else {
-      node->below = build(lower, below_upper, std::move(below), depth + 1, side);
-      node->above = build(above_lower, upper, std::move(above), depth + 1, side);
+      node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget, side);
+      node->above = build(above_lower, upper, std::move(above), depth + 1, above_budget, side);
     }
     return node;
   }
@@ -188,7 +200,7 @@ class KdBuilder {
           double cost = config_.traversal_cost +
                         config_.intersection_cost * (area_below * tests(n_below) + area_above * tests(n_above)) / area;
           if (n_below == 0 || n_above == 0) cost *= 1.0 - config_.empty_bonus;
-          if (cost < best.cost) best = {k, p, cost};
+          if (cost < best.cost) best = {k, p, cost, n_below, n_above};
         }
         left += starting + planar;
       }
@@ -247,7 +259,8 @@ KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config) {
   }
   KdBuilder builder(prims, config, depth, threads);
   std::vector<std::uint8_t> side(prims.size(), 0);
-  auto root = builder.build(prims.lower, prims.upper, std::move(events), 0, side);
+  auto root = builder.build(prims.lower, prims.upper, std::move(events), 0,
+                            kKdReferenceBudget * static_cast<double>(prims.size()), side);
   return flatten_kd_tree(prims, *root, "kdtree", "depth=" + std::to_string(depth), config.max_alloc_bytes);
 }
 
