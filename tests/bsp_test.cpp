@@ -50,17 +50,17 @@ TEST(BspBuild, ATriangleOnASplitPlaneIsInBothHalves) {
   Geometry g;
   g.source = "plane triangle";
   // Root box [0,1]^3 (padded): the first split is x = 0.5 (about).
-  g.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 1}, {1, 1, 1}, {0.5f, 0.2f, 0.2f}, {0.5f, 0.8f, 0.3f},
-                {0.5f, 0.5f, 0.9f}};
-  g.triangles = {{0, 1, 2}, {1, 3, 2}, {4, 5, 6}};
+  // One triangle in each half, one in the plane x = 0.5 (the split, or
+  // within the widening of it).
+  g.vertices = {{0, 0, 0}, {0.2f, 0, 0}, {0, 0.2f, 0.2f}, {1, 1, 1}, {0.8f, 1, 1}, {1, 0.8f, 0.8f},
+                {0.5f, 0.2f, 0.2f}, {0.5f, 0.8f, 0.3f}, {0.5f, 0.5f, 0.9f}};
+  g.triangles = {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}};
   BspConfig config;
   config.depth = 1;
   config.leaf_size = 1;
   KdTree t = build_bsp(g, config);
   ASSERT_EQ(t.nodes.size(), 3u);
-  float split = std::bit_cast<float>(t.nodes[0].data);
-  if (split == 0.5f) EXPECT_EQ(t.refs.size(), 6u);  // all three on both sides
-  else EXPECT_GE(t.refs.size(), 4u);
+  EXPECT_EQ(t.refs, (std::vector<rtcl_i32>{0, 2, 1, 2}));
 }
 
 TEST(BspBuild, BadOptionsAreErrorsNamingTheOption) {
@@ -109,8 +109,9 @@ TEST(BspTrace, MatchesBruteForceOnTheBunny) {
   expect_same_as_brute(*make_bsp(test_device(), g), g, rays, Precision::robust, false);
 }
 
-// Coincident primitives never separate: the tree reaches the depth limit,
-// the traversal stack's size, and the walk must not overflow it.
+// Coincident primitives never separate: the tree goes as deep as its
+// widened node boxes can still tell them from a plane (a chain of exactly
+// kKdMaxDepth splits is tests/kdtree_nodes_test.cpp's).
 TEST(BspTrace, CoincidentPrimitivesAtTheMaximumDepth) {
   Geometry g;
   g.source = "coincident triangles";
@@ -127,7 +128,7 @@ TEST(BspTrace, CoincidentPrimitivesAtTheMaximumDepth) {
   deepest.depth = kKdMaxDepth;
   deepest.leaf_size = 1;
   KdTree t = build_bsp(g, deepest);
-  EXPECT_EQ(t.depth, static_cast<std::uint32_t>(kKdMaxDepth));
+  EXPECT_GE(t.depth, 40u);
   std::vector<Ray> rays = split_plane_rays(t, 44, 600);
   std::mt19937 rng(45);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
