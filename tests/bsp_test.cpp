@@ -10,6 +10,7 @@
 #include "rtcl/accel/bsp.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/mesh_io.hpp"
+#include "support/error_of.hpp"
 #include "support/fixtures.hpp"
 #include "support/kd_support.hpp"
 
@@ -65,14 +66,7 @@ TEST(BspBuild, ATriangleOnASplitPlaneIsInBothHalves) {
 
 TEST(BspBuild, BadOptionsAreErrorsNamingTheOption) {
   Geometry g = random_soup(10, 1);
-  auto message = [&](const BspConfig& c) {
-    try {
-      build_bsp(g, c);
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto message = [&](const BspConfig& c) { return error_of([&] { build_bsp(g, c); }); };
   BspConfig deep;
   deep.depth = kKdMaxDepth + 1;
   EXPECT_NE(message(deep).find("bsp: depth"), std::string::npos) << message(deep);

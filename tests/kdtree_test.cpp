@@ -12,6 +12,7 @@
 #include "rtcl/bounds/clip.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/mesh_io.hpp"
+#include "support/error_of.hpp"
 #include "support/fixtures.hpp"
 #include "support/kd_support.hpp"
 
@@ -64,14 +65,7 @@ TEST(KdBuild, SahCutsOffEmptySpaceAndStopsWhenNoSplitPays) {
 
 TEST(KdBuild, BadOptionsAreErrorsNamingTheOption) {
   Geometry g = random_soup(10, 1);
-  auto message = [&](const KdTreeConfig& c) {
-    try {
-      build_kdtree(g, c);
-    } catch (const Error& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto message = [&](const KdTreeConfig& c) { return error_of([&] { build_kdtree(g, c); }); };
   KdTreeConfig deep;
   deep.depth = kKdMaxDepth + 1;
   EXPECT_NE(message(deep).find("kdtree: depth"), std::string::npos);
@@ -94,17 +88,18 @@ TEST(KdBuild, BadOptionsAreErrorsNamingTheOption) {
   }
 }
 
-Geometry soup_with_spheres(std::size_t triangles, std::uint32_t seed) {
+// A soup and a 3x3x3 lattice of spheres of growing radii through it.
+Geometry soup_and_spheres(std::size_t triangles, std::uint32_t seed) {
   Geometry g = random_soup(triangles, seed);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  for (int i = 0; i < 20; ++i) g.spheres.push_back({glm::vec3(unit(rng), unit(rng), unit(rng)), 0.01f + 0.08f * unit(rng)});
-  g.source = "soup with spheres";
+  for (int k = 0; k < 27; ++k)
+    g.spheres.push_back({glm::vec3(0.2f + 0.3f * (k % 3), 0.2f + 0.3f * (k / 3 % 3), 0.2f + 0.3f * (k / 9)),
+                         0.01f + 0.004f * static_cast<float>(k)});
+  g.source = "soup and spheres";
   return g;
 }
 
 TEST(KdTrace, MatchesBruteForceOnSoupsAndSplitPlaneRays) {
-  Geometry g = soup_with_spheres(600, 5);
+  Geometry g = soup_and_spheres(600, 5);
   KdTree t = build_kdtree(g);
   std::vector<Ray> rays = random_rays(g, 600, 6);
   std::vector<Ray> planes = split_plane_rays(t, 7, 1200);

@@ -74,22 +74,31 @@ inline int kd_clip_axis(float o, float d, float inv, float lower, float upper, f
 
 #define KD_EXIT_MARGIN (4.0f * RTCL_SLAB_WIDEN)
 
-#define KD_FLUSH_TRIANGLES()                                                      \
-  if (tri_count > 0) {                                                            \
-    int found = intersect_triangle_refs(triangles, tri_batch, tri_count, s, h);   \
-    tri_count = 0;                                                                \
-    if (found && RTCL_ANY_HIT) return;                                            \
+/* Tests a leaf's references refs[first .. end) (triangles, then spheres as
+ * ~r), eight at a time. Returns 1 when a hit ends an any-hit query. */
+inline int kd_test_leaf(global const int* refs, uint first, uint end, global const TriangleBlock* triangles,
+                        global const SphereBlock* spheres, const TraceRay* s, HitState* h) {
+  int batch[8];
+  int count = 0;
+  uint k = first;
+  for (; k < end && refs[k] >= 0; ++k) {
+    batch[count++] = refs[k];
+    if (count == 8 || k + 1 == end || refs[k + 1] < 0) {
+      if (intersect_triangle_refs(triangles, batch, count, s, h) && RTCL_ANY_HIT) return 1;
+      count = 0;
+    }
   }
 #ifdef RTCL_HAS_SPHERES
-#define KD_FLUSH_SPHERES()                                                        \
-  if (sphere_count > 0) {                                                         \
-    int found = intersect_sphere_refs(spheres, sphere_batch, sphere_count, s, h); \
-    sphere_count = 0;                                                             \
-    if (found && RTCL_ANY_HIT) return;                                            \
+  for (; k < end; ++k) {
+    batch[count++] = ~refs[k];
+    if (count == 8 || k + 1 == end) {
+      if (intersect_sphere_refs(spheres, batch, count, s, h) && RTCL_ANY_HIT) return 1;
+      count = 0;
+    }
   }
-#else
-#define KD_FLUSH_SPHERES()
 #endif
+  return 0;
+}
 
 __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, global const KdHeader* header,
                                                global const KdNode* nodes, global const int* refs,
@@ -103,12 +112,6 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
   uint stack_node[RTCL_KD_STACK];
   float stack_min[RTCL_KD_STACK], stack_max[RTCL_KD_STACK];
   int top = 0;
-  int tri_batch[8];
-  int tri_count = 0;
-#ifdef RTCL_HAS_SPHERES
-  int sphere_batch[8];
-  int sphere_count = 0;
-#endif
   uint n = 0;
   for (;;) {
     KdNode node = nodes[n];
@@ -143,21 +146,8 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
       node = nodes[n];
       axis = node.flags & 3u;
     }
-    uint end = (node.flags >> 2) + node.data;
-    for (uint k = node.flags >> 2; k < end; ++k) {
-      int r = refs[k];
-#ifdef RTCL_HAS_SPHERES
-      if (r < 0) {
-        sphere_batch[sphere_count++] = ~r;
-        if (sphere_count == 8) KD_FLUSH_SPHERES()
-        continue;
-      }
-#endif
-      tri_batch[tri_count++] = r;
-      if (tri_count == 8) KD_FLUSH_TRIANGLES()
-    }
-    KD_FLUSH_TRIANGLES()
-    KD_FLUSH_SPHERES()
+    uint first = node.flags >> 2;
+    if (kd_test_leaf(refs, first, first + node.data, triangles, spheres, s, h)) return;
     /* The next subtree whose interval may still hold a nearer hit. */
     do {
       if (top == 0) return;

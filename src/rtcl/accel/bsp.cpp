@@ -1,7 +1,6 @@
 #include "rtcl/accel/bsp.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <string>
 #include <thread>
@@ -112,19 +111,14 @@ const StructureSpec& bsp_structure() {
 
 std::unique_ptr<Accel> make_bsp(const Device& device, const Geometry& geometry, const BspConfig& config,
                                 const AccelConfig& accel_config) {
-  auto start = std::chrono::steady_clock::now();
-  GeometryReport report = validate(geometry);
-  BspConfig limited = config;
-  if (!limited.max_alloc_bytes) limited.max_alloc_bytes = device.info().max_alloc_bytes;
-  KdTree tree = build_bsp(geometry, limited);
-  AccelStats stats;
-  stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  stats.device_bytes = tree.bytes();
-  stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
-  stats.zero_area_skipped = report.zero_area_triangles;
-  stats.node_count = tree.nodes.size() - tree.leaf_count;
-  stats.leaf_count = tree.leaf_count;
-  return make_kd_accel(device, geometry, "bsp", tree, stats, accel_config);
+  return build_kd_accel(
+      device, geometry, "bsp",
+      [&](std::size_t max_alloc_bytes) {
+        BspConfig limited = config;
+        if (!limited.max_alloc_bytes) limited.max_alloc_bytes = max_alloc_bytes;
+        return build_bsp(geometry, limited);
+      },
+      accel_config);
 }
 
 std::unique_ptr<Accel> make_bsp_accel(const Device& device, const Geometry& geometry, const AccelConfig& config) {

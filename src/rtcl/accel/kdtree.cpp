@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -283,19 +282,14 @@ const StructureSpec& kdtree_structure() {
 
 std::unique_ptr<Accel> make_kdtree(const Device& device, const Geometry& geometry, const KdTreeConfig& config,
                                    const AccelConfig& accel_config) {
-  auto start = std::chrono::steady_clock::now();
-  GeometryReport report = validate(geometry);
-  KdTreeConfig limited = config;
-  if (!limited.max_alloc_bytes) limited.max_alloc_bytes = device.info().max_alloc_bytes;
-  KdTree tree = build_kdtree(geometry, limited);
-  AccelStats stats;
-  stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  stats.device_bytes = tree.bytes();
-  stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
-  stats.zero_area_skipped = report.zero_area_triangles;
-  stats.node_count = tree.nodes.size() - tree.leaf_count;
-  stats.leaf_count = tree.leaf_count;
-  return make_kd_accel(device, geometry, "kdtree", tree, stats, accel_config);
+  return build_kd_accel(
+      device, geometry, "kdtree",
+      [&](std::size_t max_alloc_bytes) {
+        KdTreeConfig limited = config;
+        if (!limited.max_alloc_bytes) limited.max_alloc_bytes = max_alloc_bytes;
+        return build_kdtree(geometry, limited);
+      },
+      accel_config);
 }
 
 std::unique_ptr<Accel> make_kdtree_accel(const Device& device, const Geometry& geometry,

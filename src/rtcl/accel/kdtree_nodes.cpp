@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cfloat>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -206,6 +207,26 @@ class KdAccel final : public Accel {
 std::unique_ptr<Accel> make_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
                                      const KdTree& tree, AccelStats stats, const AccelConfig& config) {
   return std::make_unique<KdAccel>(device, geometry, name, tree, stats, config);
+}
+
+}  // namespace rtcl
+
+namespace rtcl {
+
+std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
+                                      const std::function<KdTree(std::size_t max_alloc_bytes)>& build,
+                                      const AccelConfig& config) {
+  auto start = std::chrono::steady_clock::now();
+  GeometryReport report = validate(geometry);
+  KdTree tree = build(device.info().max_alloc_bytes);
+  AccelStats stats;
+  stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  stats.device_bytes = tree.bytes();
+  stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
+  stats.zero_area_skipped = report.zero_area_triangles;
+  stats.node_count = tree.nodes.size() - tree.leaf_count;
+  stats.leaf_count = tree.leaf_count;
+  return make_kd_accel(device, geometry, name, tree, stats, config);
 }
 
 }  // namespace rtcl

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -108,5 +109,12 @@ class KdThreads {
 // Uploads the tree as structure `name` (the kernels of accel/kdtree.cl).
 std::unique_ptr<Accel> make_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
                                      const KdTree& tree, AccelStats stats, const AccelConfig& config);
+
+// Validates the geometry, builds with build(max_alloc_bytes), the device's
+// largest buffer, and uploads as `name`; stats().build_ms covers the
+// validation and the build.
+std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
+                                      const std::function<KdTree(std::size_t max_alloc_bytes)>& build,
+                                      const AccelConfig& config);
 
 }  // namespace rtcl
