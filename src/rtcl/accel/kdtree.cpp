@@ -32,18 +32,10 @@ struct Event {
 
 using Events = std::array<std::vector<Event>, 3>;
 
-// x rounded to a float towards -inf (down) or +inf: event positions enclose
-// the double-precision bounds.
-float round_float(double x, bool down) {
-  float f = static_cast<float>(x);
-  if (down && f > x) return std::nextafter(f, -std::numeric_limits<float>::infinity());
-  if (!down && f < x) return std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
-}
-
+// Event positions enclose the double-precision bounds.
 void add_events(Events& events, std::uint32_t prim, const glm::dvec3& lower, const glm::dvec3& upper) {
   for (int k = 0; k < 3; ++k) {
-    float lo = round_float(lower[k], true), hi = round_float(upper[k], false);
+    float lo = kd_round_float(lower[k], true), hi = kd_round_float(upper[k], false);
     if (lo == hi) {
       events[k].push_back({lo, prim, kPlanar});
     } else {

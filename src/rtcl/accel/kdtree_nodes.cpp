@@ -56,15 +56,14 @@ struct Flattener {
   }
 };
 
-// x rounded to a float towards -inf (down) or +inf.
-float round_float(double x, bool down) {
+}  // namespace
+
+float kd_round_float(double x, bool down) {
   float f = static_cast<float>(x);
   if (down && f > x) return std::nextafter(f, -std::numeric_limits<float>::infinity());
   if (!down && f < x) return std::nextafter(f, std::numeric_limits<float>::infinity());
   return f;
 }
-
-}  // namespace
 
 std::size_t KdTree::bytes() const {
   return sizeof(KdHeader) + nodes.size() * sizeof(KdNode) + refs.size() * sizeof(rtcl_i32) + blocks.bytes();
@@ -129,8 +128,8 @@ KdPrimitives kd_primitives(const Geometry& geometry, const std::string& structur
   double pad = std::max(16.0 * FLT_EPSILON * magnitude, static_cast<double>(FLT_MIN));
   p.widen = 64.0 * FLT_EPSILON * magnitude + static_cast<double>(FLT_MIN);
   for (int a = 0; a < 3; ++a) {
-    p.lower[a] = round_float(lower[a] - pad, true);
-    p.upper[a] = round_float(upper[a] + pad, false);
+    p.lower[a] = kd_round_float(lower[a] - pad, true);
+    p.upper[a] = kd_round_float(upper[a] + pad, false);
   }
   return p;
 }

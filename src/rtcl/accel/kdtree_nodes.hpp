@@ -73,6 +73,10 @@ struct KdPrimitives {
   void bounds(std::uint32_t i, glm::dvec3* lower, glm::dvec3* upper) const;
 };
 
+// x rounded to a float towards -inf (down) or +inf: float bounds that
+// enclose double ones.
+float kd_round_float(double x, bool down);
+
 // The stored primitives of validated geometry and the root box: the scene
 // box padded by 16 float ulps of its magnitude and rounded outwards to
 // float. `structure` names the builder in errors: the primitive blocks
