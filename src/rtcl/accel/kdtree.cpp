@@ -159,7 +159,7 @@ class KdBuilder {
   // Intersection tests a leaf of n primitives costs: one per batch of
   // config.batch (the kernel tests up to 8 at once in float8 lanes).
   double tests(std::size_t n) const {
-    return static_cast<double>((n + config_.batch - 1) / config_.batch);
+    return static_cast<double>(config_.batch == 1 ? n : (n + config_.batch - 1) / config_.batch);
   }
 
   // The sweep over each axis's sorted events (Wald & Havran 2006,
@@ -172,9 +172,11 @@ class KdBuilder {
     Split best;
     best.cost = config_.intersection_cost * tests(n);
     if (!(area > 0.0)) return best;
+    // cost = ct + ci / area * (area_below * N_below + area_above * N_above)
+    const double scale = config_.intersection_cost / area;
     for (int k = 0; k < 3; ++k) {
       int a = (k + 1) % 3, b = (k + 2) % 3;
-      double cross = e[a] * e[b], perimeter = e[a] + e[b];
+      double cross = 2.0 * e[a] * e[b], perimeter = 2.0 * (e[a] + e[b]);
       std::size_t left = 0, right = n;
       const std::vector<Event>& list = events[k];
       for (std::size_t i = 0; i < list.size();) {
@@ -186,10 +188,10 @@ class KdBuilder {
         right -= planar + ending;
         if (p > lower[k] && p < upper[k]) {
           std::size_t n_below = left + planar, n_above = right + planar;
-          double area_below = 2.0 * (cross + (p - lower[k]) * perimeter);
-          double area_above = 2.0 * (cross + (upper[k] - p) * perimeter);
-          double cost = config_.traversal_cost +
-                        config_.intersection_cost * (area_below * tests(n_below) + area_above * tests(n_above)) / area;
+          double area_below = cross + (p - lower[k]) * perimeter;
+          double area_above = cross + (upper[k] - p) * perimeter;
+          double cost =
+              config_.traversal_cost + scale * (area_below * tests(n_below) + area_above * tests(n_above));
           if (n_below == 0 || n_above == 0) cost *= 1.0 - config_.empty_bonus;
           if (cost < best.cost) best = {k, p, cost, n_below, n_above};
         }
