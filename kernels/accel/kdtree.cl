@@ -24,6 +24,9 @@
  *     touches the plane from one side may be listed on that side only);
  *   - dist exactly at min or max: both children (one of them over an empty
  *     or one-point interval).
+ * Where the interval reaches both children and one of them is an empty
+ * leaf (the SAH's cut-off empty space), the walk goes on with the other
+ * over its part of the interval, pushing nothing.
  * The comparisons are conservative: the plane counts as inside the interval
  * when it is within RTCL_SLAB_WIDEN (relative) of it, which covers the
  * rounding of dist and of the interval ends; the intervals themselves are
@@ -73,6 +76,9 @@ inline int kd_clip_axis(float o, float d, float inv, float lower, float upper, f
 }
 
 #define KD_EXIT_MARGIN (4.0f * RTCL_SLAB_WIDEN)
+
+/* A leaf with no references (the SAH's cut-off empty space). */
+#define KD_EMPTY(node) (((node).flags & 3u) == RTCL_KD_LEAF && (node).data == 0u)
 
 /* Tests a leaf's references refs[first .. end) (triangles, then spheres as
  * ~r), eight at a time. Returns 1 when a hit ends an any-hit query. */
@@ -125,23 +131,41 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
       uint below = n + 1, above = node.flags >> 2;
       int below_near = delta > 0.0f || (delta == 0.0f && d > 0.0f);
       uint near = below_near ? below : above, far = below_near ? above : below;
-      if (rtcl_is_nan(dist)) { /* in the plane */
-        stack_node[top] = far;
-        stack_min[top] = t_min;
-        stack_max[top] = t_max;
-        ++top;
-        n = near;
-      } else if (dist < 0.0f || dist * (1.0f - RTCL_SLAB_WIDEN) > t_max) {
-        n = near;
-      } else if (dist * (1.0f + RTCL_SLAB_WIDEN) < t_min) {
-        n = far;
-      } else {
-        stack_node[top] = far;
-        stack_min[top] = fmax(t_min, dist);
-        stack_max[top] = t_max;
-        ++top;
-        t_max = fmin(t_max, dist);
-        n = near;
+      int both = rtcl_is_nan(dist); /* in the plane: both, each over the whole interval */
+      if (!both) {
+        if (dist < 0.0f || dist * (1.0f - RTCL_SLAB_WIDEN) > t_max) {
+          n = near;
+        } else if (dist * (1.0f + RTCL_SLAB_WIDEN) < t_min) {
+          n = far;
+        } else {
+          both = 1;
+        }
+      }
+      if (both) {
+        /* An empty leaf on either side is not visited (nor pushed). */
+        KdNode far_node = nodes[far];
+        if (KD_EMPTY(far_node)) {
+          if (!rtcl_is_nan(dist)) t_max = fmin(t_max, dist);
+          n = near;
+        } else {
+          KdNode near_node = nodes[near];
+          if (KD_EMPTY(near_node)) {
+            if (!rtcl_is_nan(dist)) t_min = fmax(t_min, dist);
+            n = far;
+            node = far_node;
+            axis = node.flags & 3u;
+            continue;
+          }
+          stack_node[top] = far;
+          stack_min[top] = rtcl_is_nan(dist) ? t_min : fmax(t_min, dist);
+          stack_max[top] = t_max;
+          ++top;
+          if (!rtcl_is_nan(dist)) t_max = fmin(t_max, dist);
+          n = near;
+          node = near_node;
+          axis = node.flags & 3u;
+          continue;
+        }
       }
       node = nodes[n];
       axis = node.flags & 3u;
