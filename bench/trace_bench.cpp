@@ -205,7 +205,7 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
   for (const char* ct : {"ct=10", "ct=15", "ct=30", "ct=60", "ct=120", "batch=8,ct=5", "batch=8,ct=10",
                          "batch=8,ct=20", "batch=4,ct=15"})
     specs.push_back(std::string("kdtree:") + ct);
-  for (const char* o : {"depth=14", "depth=18", "depth=22", "leaf=2", "leaf=12"}) specs.push_back(std::string("bsp:") + o);
+  for (const char* o : {"depth=14", "depth=18", "depth=22", "depth=26", "leaf=2", "leaf=12"}) specs.push_back(std::string("bsp:") + o);
   for (RayKind kind : {RayKind::primary, RayKind::diffuse})
     for (const std::string& accel : specs) {
       std::string name = accel;

@@ -77,7 +77,7 @@ class BspBuilder {
 int bsp_depth(const BspConfig& config, std::size_t primitives) {
   if (config.depth > 0) return config.depth;
   double n = static_cast<double>(std::max<std::size_t>(primitives, 1));
-  return std::clamp(static_cast<int>(std::lround(std::log2(n))) + 2, 1, kKdMaxDepth);
+  return std::clamp(static_cast<int>(std::lround(std::log2(n))) + 6, 1, kKdMaxDepth);
 }
 
 KdTree build_bsp(const Geometry& geometry, const BspConfig& config) {
@@ -102,7 +102,7 @@ const StructureSpec& bsp_structure() {
   static const StructureSpec spec{
       "bsp", "axis-aligned BSP: midpoint splits, axis x->y->z by depth, [min,max] interval traversal",
       {{"depth", OptionType::integer, std::int64_t{0}, 0, kKdMaxDepth, false,
-        "deepest leaf in splits, at most the traversal stack; 0: round(log2 N) + 2. Deeper cuts clusters finer "
+        "deepest leaf in splits, at most the traversal stack; 0: round(log2 N) + 6. Deeper cuts clusters finer "
         "for more nodes and more straddling references"},
        {"leaf", OptionType::integer, std::int64_t{BspConfig{}.leaf_size}, 1, 1024, false,
         "a node with at most this many primitives is a leaf: fewer test less per leaf for more nodes to walk"}}};
