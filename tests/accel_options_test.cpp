@@ -137,7 +137,7 @@ TEST(AccelOptions, SceneFilesNameAStructureWithOptions) {
        std::vector<std::pair<std::string, std::string>>{{"{\"name\": \"grid\", \"lambda\": -1}", "lambda must be > 0"},
                                                         {"{\"name\": \"grid\", \"size\": 3}", "unknown option size"},
                                                         {"{\"lambda\": 3}", "missing required key 'name'"},
-                                                        {"\"kdtree\"", "unknown acceleration structure"},
+                                                        {"\"no-such-tree\"", "unknown acceleration structure"},
                                                         {"3", "expected a string or an object"}}) {
     try {
       load_scene(scene_with(text));

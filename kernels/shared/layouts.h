@@ -155,6 +155,31 @@ typedef struct OctreePtrHeader {
   rtcl_i32 pad;
 } OctreePtrHeader;
 
+/* A BSP / kd-tree node (kernels/accel/kdtree.cl; built by
+ * src/rtcl/accel/bsp.cpp and kdtree.cpp): 8 bytes, in depth-first order.
+ * flags bits 0..1: the split axis 0, 1, 2 (x, y, z) of an inner node, or
+ * RTCL_KD_LEAF. Inner node n: its child below the plane (coordinate <=
+ * split) is node n + 1, its child above (>= split) is node flags >> 2, and
+ * data holds the split coordinate's float bits. Leaf: its references are
+ * refs[(flags >> 2) .. (flags >> 2) + data), triangles first as r >= 0 (lane
+ * r & 7 of triangle block r >> 3, id-ordered blocks), then spheres as ~r < 0,
+ * each kind in ascending order. Every index is < 2^30. */
+typedef struct KdNode {
+  rtcl_u32 flags;
+  rtcl_u32 data;
+} KdNode;
+#define RTCL_KD_LEAF 3u
+#define RTCL_KD_INNER(axis, above) ((rtcl_u32)(axis) | ((rtcl_u32)(above) << 2))
+#define RTCL_KD_LEAF_NODE(first) (RTCL_KD_LEAF | ((rtcl_u32)(first) << 2))
+
+/* The tree's root box [lower, upper] (closed, float), which contains every
+ * stored primitive; traversal clips the ray to it. 32 bytes; element [3] of
+ * each row is unused. */
+typedef struct KdHeader {
+  float lower[4];
+  float upper[4];
+} KdHeader;
+
 #ifndef __OPENCL_VERSION__
 } /* namespace rtcl */
 #endif

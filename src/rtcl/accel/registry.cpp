@@ -5,11 +5,13 @@
 
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/accel/brute.hpp"
+#include "rtcl/accel/bsp.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/grid.hpp"
 #include "rtcl/accel/octree.hpp"
 #include "rtcl/accel/octree_ptr.hpp"
 #include "rtcl/accel/octree_r.hpp"
+#include "rtcl/accel/kdtree.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {
@@ -33,6 +35,8 @@ const std::vector<Entry>& registry() {
       {octree_structure(), make_octree_accel},
       {octree_ptr_structure(), make_octree_ptr_accel},
       {octree_r_structure(), make_octree_r_accel},
+      {bsp_structure(), make_bsp_accel},
+      {kdtree_structure(), make_kdtree_accel},
   };
   return entries;
 }

@@ -1,0 +1,63 @@
+// SAH kd-tree (Havran 2000; Wald & Havran 2006, "On building fast kd-trees
+// for ray tracing, and on doing that in O(N log N)"): the BSP's nodes with
+// the split plane placed freely, chosen by the surface area heuristic over
+// the sorted boundary events of the node's primitives, whose bounds are
+// those of the triangles clipped to the node box ("perfect splits"). Same
+// nodes and traversal as the BSP (kdtree_nodes.hpp, kernels/accel/kdtree.cl).
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "rtcl/accel/kdtree_nodes.hpp"
+
+namespace rtcl {
+
+struct KdTreeConfig {
+  // Deepest leaf, in splits (<= kKdMaxDepth); 0 = auto: round(8 + 1.3
+  // log2 N) for N stored primitives (pbrt's rule), at most kKdMaxDepth.
+  int depth = 0;
+  // SAH costs (Wald & Havran 2006, section 4.1): a split of a node with
+  // surface area SA into children L, R costs
+  //   traversal_cost + intersection_cost * (SA_L / SA * N_L + SA_R / SA * N_R),
+  // times (1 - empty_bonus) when one side is empty; a leaf costs
+  // intersection_cost * N, and a node whose best split costs more is a leaf.
+  // Only the ratio of the two costs matters. Mitsuba uses 15 and 20; on
+  // PoCL a node step is dearer relative to a test (README, "BSP and
+  // kd-tree": bench sweep/<scene>/<kind>/kdtree/ct=...), 30 was the best
+  // of 10..120 on the bunny's primary rays.
+  double traversal_cost = 30.0;
+  double intersection_cost = 20.0;
+  // The empty-space bonus in [0, 1) (Wald & Havran's 0.8 factor = 0.2):
+  // favours splits that cut off empty space, which the interval traversal
+  // skips for the price of one node.
+  double empty_bonus = 0.2;
+  // Primitives one intersection test covers in the cost model, 1..8: 1 is
+  // the classic SAH (cost per primitive); the kernel tests a leaf in
+  // batches of 8 float8 lanes, where 1 and 8 triangles cost the same.
+  unsigned batch = 1;
+  // Host threads (0 = hardware concurrency) for subtrees of nodes with at
+  // least 4096 primitives, and for sorting the root's events per axis.
+  unsigned thread_count = 0;
+  // The largest buffer the device can allocate (0: no limit).
+  std::size_t max_alloc_bytes = 0;
+};
+
+// The depth the build uses for `primitives` stored primitives.
+int kdtree_depth(const KdTreeConfig& config, std::size_t primitives);
+
+// Builds over the stored primitives of validated geometry. Throws Error
+// naming the option for a bad config or a tree too large for the device.
+KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config = {});
+
+// Its registry entry: depth, ct (traversal_cost), ci (intersection_cost),
+// empty (empty_bonus).
+const StructureSpec& kdtree_structure();
+
+std::unique_ptr<Accel> make_kdtree_accel(const Device& device, const Geometry& geometry, const AccelConfig& config);
+
+// Builds and uploads; stats().build_ms covers build_kdtree.
+std::unique_ptr<Accel> make_kdtree(const Device& device, const Geometry& geometry, const KdTreeConfig& config = {},
+                                   const AccelConfig& accel_config = {});
+
+}  // namespace rtcl

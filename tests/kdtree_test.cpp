@@ -1,0 +1,169 @@
+// The SAH kd-tree (src/rtcl/accel/kdtree.cpp, kernels/accel/kdtree.cl):
+// splits placed by the SAH over sorted events, perfect splits, leaves when
+// no split pays, and traversal answers identical to brute force on soups
+// with spheres, the bunny, a flat scene and rays in and on split planes.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <random>
+
+#include "rtcl/accel/bsp.hpp"
+#include "rtcl/accel/kdtree.hpp"
+#include "rtcl/bounds/clip.hpp"
+#include "rtcl/error.hpp"
+#include "rtcl/scene/mesh_io.hpp"
+#include "support/error_of.hpp"
+#include "support/fixtures.hpp"
+#include "support/kd_support.hpp"
+
+namespace rtcl::test {
+namespace {
+
+TEST(KdClip, ClippedBoundsAreThoseOfThePartInsideTheBox) {
+  glm::dvec3 lo, hi;
+  // A triangle crossing x = 0.5: the part in x <= 0.5.
+  ASSERT_TRUE(clip_triangle_bounds({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {-1, -1, -1}, {0.5, 2, 2}, &lo, &hi));
+  EXPECT_EQ(hi.x, 0.5);
+  EXPECT_EQ(hi.y, 1.0);
+  // The part in x >= 0.5 reaches only y <= 0.5 (perfect split).
+  ASSERT_TRUE(clip_triangle_bounds({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.5, -1, -1}, {2, 2, 2}, &lo, &hi));
+  EXPECT_EQ(lo.x, 0.5);
+  EXPECT_DOUBLE_EQ(hi.y, 0.5);
+  // Its box meets [0.6, 1] x [0.6, 1], the triangle does not.
+  EXPECT_FALSE(clip_triangle_bounds({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0.6, 0.6, -1}, {1, 1, 1}, &lo, &hi));
+  // Touching in a vertex keeps the vertex.
+  ASSERT_TRUE(clip_triangle_bounds({0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, -1, -1}, {2, 1, 1}, &lo, &hi));
+  EXPECT_EQ(lo.x, 1.0);
+  EXPECT_EQ(hi.x, 1.0);
+}
+
+TEST(KdBuild, SahCutsOffEmptySpaceAndStopsWhenNoSplitPays) {
+  // Two clusters far apart: the first split separates them.
+  Geometry a = random_soup(200, 1, 0.02f, 0.1f);
+  Geometry b = random_soup(200, 2, 0.02f, 0.1f, glm::vec3(0.9f));
+  Geometry g = a;
+  auto base = static_cast<std::uint32_t>(g.vertices.size());
+  g.vertices.insert(g.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (glm::uvec3 t : b.triangles) g.triangles.push_back(t + base);
+  g.source = "two clusters";
+  KdTree t = build_kdtree(g);
+  ASSERT_NE(t.nodes[0].flags & 3u, RTCL_KD_LEAF);
+  float split = std::bit_cast<float>(t.nodes[0].data);
+  EXPECT_GT(split, 0.1f);
+  EXPECT_LT(split, 0.9f);
+  EXPECT_LE(t.depth, static_cast<std::uint32_t>(kdtree_depth({}, 400)));
+  // One triangle: no split beats the leaf.
+  Geometry one;
+  one.source = "one triangle";
+  one.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  one.triangles = {{0, 1, 2}};
+  EXPECT_EQ(build_kdtree(one).nodes.size(), 1u);
+  // Fewer straddling references than the BSP on the same soup.
+  Geometry soup = random_soup(3000, 3);
+  EXPECT_LT(build_kdtree(soup).references_per_primitive(), build_bsp(soup).references_per_primitive());
+}
+
+TEST(KdBuild, BadOptionsAreErrorsNamingTheOption) {
+  Geometry g = random_soup(10, 1);
+  auto message = [&](const KdTreeConfig& c) { return error_of([&] { build_kdtree(g, c); }); };
+  KdTreeConfig deep;
+  deep.depth = kKdMaxDepth + 1;
+  EXPECT_NE(message(deep).find("kdtree: depth"), std::string::npos);
+  KdTreeConfig ct;
+  ct.traversal_cost = 0.0;
+  EXPECT_NE(message(ct).find("kdtree: ct"), std::string::npos);
+  KdTreeConfig ci;
+  ci.intersection_cost = -1.0;
+  EXPECT_NE(message(ci).find("kdtree: ci"), std::string::npos);
+  KdTreeConfig tiny;
+  tiny.max_alloc_bytes = 64;
+  EXPECT_NE(message(tiny).find("CL_DEVICE_MAX_MEM_ALLOC_SIZE"), std::string::npos);
+  for (const char* spec : {"kdtree:depth=65", "kdtree:ct=0", "kdtree:ci=-2", "kdtree:empty=1"}) {
+    try {
+      make_accel(test_device(), spec, g);
+      ADD_FAILURE() << spec << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("kdtree"), std::string::npos) << e.what();
+    }
+  }
+}
+
+// A soup and a 3x3x3 lattice of spheres of growing radii through it.
+Geometry soup_and_spheres(std::size_t triangles, std::uint32_t seed) {
+  Geometry g = random_soup(triangles, seed);
+  for (int k = 0; k < 27; ++k)
+    g.spheres.push_back({glm::vec3(0.2f + 0.3f * (k % 3), 0.2f + 0.3f * (k / 3 % 3), 0.2f + 0.3f * (k / 9)),
+                         0.01f + 0.004f * static_cast<float>(k)});
+  g.source = "soup and spheres";
+  return g;
+}
+
+TEST(KdTrace, MatchesBruteForceOnSoupsAndSplitPlaneRays) {
+  Geometry g = soup_and_spheres(600, 5);
+  KdTree t = build_kdtree(g);
+  std::vector<Ray> rays = random_rays(g, 600, 6);
+  std::vector<Ray> planes = split_plane_rays(t, 7, 1200);
+  rays.insert(rays.end(), planes.begin(), planes.end());
+  for (Precision level : test_precisions())
+    expect_same_as_brute(*make_kdtree(test_device(), g, {}, AccelConfig{level, {}}), g, rays, level);
+}
+
+TEST(KdTrace, MatchesBruteForceOnTheBunny) {
+  Geometry g = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
+  validate(g);
+  std::vector<Ray> rays = random_rays(g, 800, 41);
+  std::mt19937 rng(42);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  Aabb box = g.bounds();
+  for (int i = 0; i < 400; ++i) {  // origins inside leaves
+    glm::vec3 o = box.lower + box.extent() * glm::vec3(unit(rng), unit(rng), unit(rng));
+    rays.push_back({o.x, o.y, o.z, normal(rng), normal(rng), normal(rng), 0.0f, INFINITY});
+  }
+  std::vector<Ray> planes = split_plane_rays(build_kdtree(g), 43, 800);
+  rays.insert(rays.end(), planes.begin(), planes.end());
+  expect_same_as_brute(*make_kdtree(test_device(), g), g, rays, Precision::robust, false);
+}
+
+// A scene flat along z (every split on z would be useless), a grid of
+// triangles with shared edges on the split planes.
+TEST(KdTrace, FlatSceneAndSharedEdgesOnSplitPlanes) {
+  Geometry g;
+  g.source = "flat grid";
+  const int n = 16;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) g.vertices.push_back({i / float(n), j / float(n), 0.25f});
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      std::uint32_t v = j * (n + 1) + i;
+      g.triangles.push_back({v, v + 1, v + n + 2});
+      g.triangles.push_back({v, v + n + 2, v + n + 1});
+    }
+  KdTree t = build_kdtree(g);
+  std::vector<Ray> rays = split_plane_rays(t, 8, 900);
+  std::mt19937 rng(9);
+  std::uniform_int_distribution<int> k(0, n);
+  for (int i = 0; i < 300; ++i) {  // straight down through grid vertices and edges
+    float x = k(rng) / float(n), y = (k(rng) + 0.5f * (i % 2)) / float(n);
+    rays.push_back({x, y, 1.0f, (i % 3) ? 0.0f : -0.0f, 0.0f, -1.0f, 0.0f, INFINITY});
+  }
+  for (Precision level : test_precisions()) {
+    expect_same_as_brute(*make_kdtree(test_device(), g, {}, AccelConfig{level, {}}), g, rays, level);
+    expect_same_as_brute(*make_bsp(test_device(), g, {}, AccelConfig{level, {}}), g, rays, level);
+  }
+}
+
+TEST(KdTrace, ReportsStats) {
+  Geometry g = random_soup(1000, 4);
+  auto kd = make_kdtree(test_device(), g);
+  EXPECT_EQ(kd->name(), "kdtree");
+  KdTree host = build_kdtree(g);
+  EXPECT_EQ(kd->stats().device_bytes, host.bytes());
+  EXPECT_EQ(kd->stats().leaf_count, host.leaf_count);
+  EXPECT_EQ(kd->stats().primitive_count, 1000u);
+  EXPECT_EQ(make_accel(test_device(), "kdtree:depth=20,ct=10,ci=30,empty=0.5", g)->name(), "kdtree");
+  EXPECT_EQ(make_accel(test_device(), "bsp:depth=12,leaf=3", g)->name(), "bsp");
+}
+
+}  // namespace
+}  // namespace rtcl::test
