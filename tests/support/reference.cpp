@@ -1,10 +1,12 @@
 #include "support/reference.hpp"
 
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include <glm/glm.hpp>
 
@@ -156,8 +158,22 @@ std::vector<std::string> judge_rays(const Geometry& g, const std::vector<Ray>& r
   std::vector<std::string> out;
   *failures = 0;
   Aabb box = g.bounds();
+  // Each ray is judged on its own: contiguous ranges on every hardware
+  // thread, the verdicts then read in ray order.
+  std::vector<std::string> verdicts(rays.size());
+  auto judge_range = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i)
+      verdicts[i] = judge_in(g, box, rays[i], hits[i], query, references ? &(*references)[i] : nullptr);
+  };
+  std::size_t threads = std::max(1u, std::thread::hardware_concurrency());
+  if (rays.size() < 256) threads = 1;
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < threads; ++t)
+    pool.emplace_back(judge_range, rays.size() * t / threads, rays.size() * (t + 1) / threads);
+  judge_range(0, rays.size() / threads);
+  for (std::thread& t : pool) t.join();
   for (std::size_t i = 0; i < rays.size(); ++i) {
-    std::string why = judge_in(g, box, rays[i], hits[i], query, references ? &(*references)[i] : nullptr);
+    const std::string& why = verdicts[i];
     if (why.empty()) continue;
     ++*failures;
     if (out.size() < report) {

@@ -130,7 +130,7 @@ Octree build_octree(const Geometry& geometry, const OctreeConfig& config) {
   for (std::size_t b = 0; b < buckets; ++b) {
     std::uint64_t prefix = 0;
     for (int l = 0; l < t; ++l) prefix = (prefix << 4) | ((b >> (3 * (t - 1 - l))) & 7u);
-    prefix <<= 4 * (n - t);
+    prefix = n - t < 16 ? prefix << (4 * (n - t)) : 0;  // t = 0 at depth 16: no digits, shift would be 64
     out.bucket_begin[b] = static_cast<rtcl_u32>(std::lower_bound(out.codes.begin(), out.codes.end(), prefix) -
                                                 out.codes.begin());
   }
