@@ -317,8 +317,8 @@ Grid build_grid(const Geometry& geometry, const GridConfig& config) {
           octant |= (upper ? 1 : 0) << a;
           sub |= (at[a] >= mid ? 1 : 0) << a;
         }
-        for (int box : {octant * 8 + sub}) 
-          for (int a = 0; a < 3; ++a) lo[box][a] = std::min(lo[box][a], at[a]), hi[box][a] = std::max(hi[box][a], at[a]);
+        const int box = octant * 8 + sub;
+        for (int a = 0; a < 3; ++a) lo[box][a] = std::min(lo[box][a], at[a]), hi[box][a] = std::max(hi[box][a], at[a]);
       }
   auto set_box = [&](float* rows, int lane, const std::int64_t* l, const std::int64_t* u) {
     for (int a = 0; a < 3; ++a) {

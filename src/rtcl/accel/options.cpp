@@ -29,9 +29,9 @@ bool parse_int(std::string_view text, std::int64_t* out) {
 }
 
 bool in_range(const OptionSpec& spec, double x) {
-  if (spec.power_of_two && !(x >= 1.0 && (static_cast<std::int64_t>(x) & (static_cast<std::int64_t>(x) - 1)) == 0))
-    return false;
-  return (spec.min_exclusive ? x > spec.min : x >= spec.min) && x <= spec.max;
+  if (!((spec.min_exclusive ? x > spec.min : x >= spec.min) && x <= spec.max)) return false;
+  // Within [min, max] first: the cast below then cannot overflow.
+  return !spec.power_of_two || (x >= 1.0 && (static_cast<std::int64_t>(x) & (static_cast<std::int64_t>(x) - 1)) == 0);
 }
 
 std::string option_list(const StructureSpec& s) {
