@@ -26,10 +26,10 @@ struct GridConfig {
   // The lecture's trade-off: fewer cells make long lists, more make many
   // empty cells to walk and more memory. Measured (bench sweep/, PoCL, 2
   // cores, README "Uniform grid"): time per ray is U-shaped in the cell
-  // count with its minimum at lambda 4..16 on bunny, sponza and sibenik
-  // (primary and diffuse rays); 8 was the best on three of those six sets,
-  // within 7% on two and 24% behind lambda 4 on the bunny's primary rays,
-  // at ~90 bytes per triangle (40 of them triangle blocks).
+  // count, flat within 18% from lambda 2 to 16 on bunny, sponza and sibenik
+  // (primary and diffuse rays); 8 was the best lambda on three of those six
+  // sets and within 8% on the others, at 160-260 bytes per triangle (40
+  // per reference lane).
   double lambda = 8.0;
   // Explicit resolution; overrides lambda when not {0, 0, 0}.
   GridResolution resolution{0, 0, 0};
