@@ -19,6 +19,7 @@
 #include "rtcl/accel/octree.hpp"
 #include "rtcl/accel/octree_ptr.hpp"
 #include "rtcl/accel/octree_r.hpp"
+#include "rtcl/bounds/clip.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "support/error_of.hpp"
@@ -166,7 +167,7 @@ TEST(OctreeCode, PointCodeLowerCornerRoundTripsAtEveryDepth) {
   for (int depth = 0; depth <= RTCL_OCTREE_MAX_DEPTH; ++depth) {
     std::uint32_t side = 1u << depth;
     for (int trial = 0; trial < 50; ++trial) {
-      std::array<std::uint32_t, 3> p{rng() % side, rng() % side, rng() % side};
+      std::array<std::uint32_t, 3> p{std::uint32_t(rng() % side), std::uint32_t(rng() % side), std::uint32_t(rng() % side)};
       if (trial == 0) p = {side - 1, side - 1, side - 1};
       std::uint64_t q = octree_point_code(p, depth);
       for (int l = 1; l <= depth; ++l)  // property 1, digit by digit
@@ -207,6 +208,76 @@ TEST(OctreeBuild, TableIsSortedBucketedAndListsEveryPrimitive) {
       for (rtcl_i32 p : b.prim) copies += p >= 0 && ++seen[std::size_t(p)] > 0;
     EXPECT_EQ(std::count(seen.begin(), seen.end(), 0), 0) << "a primitive in no leaf";
     EXPECT_EQ(copies, tree.ref_count);
+  }
+}
+
+// The pointer octrees' boxes: walking the tree from the root box through
+// the split planes, the part of each leaf triangle inside the leaf's cell
+// (clipped in double, an independent computation) lies in its block's
+// BlockBox and in the occupied box of the root child above the leaf, and so
+// does each leaf sphere's box within the cell.
+TEST(OctreeBuild, BlockBoxesAndOccupiedBoundsHoldWhatTheLeavesHold) {
+  Geometry g = soup_with_spheres(600, 11);
+  for (bool cost : {false, true}) {
+    SCOPED_TRACE(cost ? "octree-r" : "octree-ptr");
+    OctreePtr tree = cost ? build_octree_r(g) : build_octree_ptr(g);
+    ASSERT_EQ(tree.block_boxes.size(), tree.blocks.triangles.size());
+    auto inside = [](const glm::dvec3& lo, const glm::dvec3& hi, const float* b) {
+      for (int a = 0; a < 3; ++a)
+        if (lo[a] < double(b[a]) || hi[a] > double(b[3 + a])) return false;
+      return true;
+    };
+    struct Visit {
+      rtcl_i32 ref;
+      glm::dvec3 lo, hi;
+      int octant;
+    };
+    glm::dvec3 root_lo(tree.header.lower[0], tree.header.lower[1], tree.header.lower[2]);
+    glm::dvec3 root_hi(tree.header.upper[0], tree.header.upper[1], tree.header.upper[2]);
+    std::vector<Visit> todo = {{tree.header.root, root_lo, root_hi, 0}};
+    std::size_t checked = 0;
+    while (!todo.empty()) {
+      Visit v = todo.back();
+      todo.pop_back();
+      if (v.ref == RTCL_CHILD_EMPTY) continue;
+      if (v.ref >= 0) {
+        const OctreeNode& n = tree.nodes[std::size_t(v.ref)];
+        for (int q = 0; q < 8; ++q) {
+          glm::dvec3 lo = v.lo, hi = v.hi;
+          for (int a = 0; a < 3; ++a) ((q >> a) & 1 ? lo[a] : hi[a]) = n.split[a];
+          todo.push_back({n.child[q], lo, hi, v.ref == tree.header.root ? q : v.octant});
+        }
+        continue;
+      }
+      std::array<float, 6> occupied;
+      for (int r = 0; r < 6; ++r) occupied[std::size_t(r)] = tree.header.occupied_bounds[r][v.octant];
+      auto leaf = std::size_t(~v.ref);
+      for (rtcl_u32 b = tree.leaf_begin[2 * leaf]; b < tree.leaf_begin[2 * leaf + 2]; ++b) {
+        const TriangleBlock& block = tree.blocks.triangles[b];
+        for (int l = 0; l < RTCL_BLOCK_WIDTH; ++l) {
+          if (block.prim[l] < 0) continue;
+          glm::dvec3 p[3];
+          for (int k = 0; k < 3; ++k) p[k] = glm::dvec3(block.v[k][0][l], block.v[k][1][l], block.v[k][2][l]);
+          glm::dvec3 lo, hi;
+          if (!clip_triangle_bounds(p[0], p[1], p[2], v.lo, v.hi, &lo, &hi)) continue;
+          EXPECT_TRUE(inside(lo, hi, tree.block_boxes[b].bounds)) << "prim " << block.prim[l] << " block " << b;
+          EXPECT_TRUE(inside(lo, hi, occupied.data())) << "prim " << block.prim[l] << " octant " << v.octant;
+          ++checked;
+        }
+      }
+      for (rtcl_u32 b = tree.leaf_begin[2 * leaf + 1]; b < tree.leaf_begin[2 * leaf + 3]; ++b) {
+        const SphereBlock& block = tree.blocks.spheres[b];
+        for (int l = 0; l < RTCL_BLOCK_WIDTH; ++l) {
+          if (block.prim[l] < 0) continue;
+          glm::dvec3 c(block.cx[l], block.cy[l], block.cz[l]);
+          glm::dvec3 lo = glm::max(c - double(block.r[l]), v.lo), hi = glm::min(c + double(block.r[l]), v.hi);
+          if (glm::any(glm::greaterThan(lo, hi))) continue;
+          EXPECT_TRUE(inside(lo, hi, occupied.data())) << "sphere " << block.prim[l] << " octant " << v.octant;
+          ++checked;
+        }
+      }
+    }
+    EXPECT_GT(checked, 600u);
   }
 }
 

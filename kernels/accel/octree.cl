@@ -113,7 +113,7 @@ inline float octree_lattice(float p, float lower, float cell, int step) {
 __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, global const OctreeHeader* header,
                                                global const ulong* codes, global const uint* leaf_begin,
                                                global const uint* bucket_begin, global const TriangleBlock* triangles,
-                                               global const SphereBlock* spheres) {
+                                               global const SphereBlock* spheres, global const BlockBox* boxes) {
   const OctreeHeader g = *header;
   if (g.leaf_count == 0) return;
   const uint side = 1u << g.depth;
@@ -133,7 +133,7 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
   for (;;) {
     int leaf;
     int level = octree_lookup(octree_point_code(p[0], p[1], p[2]), &g, codes, bucket_begin, &leaf);
-    if (leaf >= 0 && octree_test_leaf((uint)leaf, leaf_begin, triangles, spheres, s, h)) return;
+    if (leaf >= 0 && octree_test_leaf((uint)leaf, leaf_begin, triangles, spheres, boxes, s, h)) return;
     /* property 2: the cell's lower corner and side */
     const uint size = 1u << (g.depth - level);
     uint lower[3];
@@ -169,6 +169,7 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
 
 #define OCTREE_PARAMS                                                                                  \
   global const OctreeHeader *header, global const ulong *codes, global const uint *leaf_begin,         \
-      global const uint *bucket_begin, global const TriangleBlock *triangles, global const SphereBlock *spheres
-#define OCTREE_ARGS header, codes, leaf_begin, bucket_begin, triangles, spheres
+      global const uint *bucket_begin, global const TriangleBlock *triangles, global const SphereBlock *spheres, \
+      global const BlockBox *boxes
+#define OCTREE_ARGS header, codes, leaf_begin, bucket_begin, triangles, spheres, boxes
 RTCL_TRACE_KERNELS(octree, OCTREE_PARAMS, OCTREE_ARGS)

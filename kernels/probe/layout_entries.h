@@ -40,10 +40,13 @@ RTCL_PROBE_RECORD(OctreeHeader)
 RTCL_PROBE_FIELD(OctreeHeader, lower) RTCL_PROBE_FIELD(OctreeHeader, cell) RTCL_PROBE_FIELD(OctreeHeader, depth)
 RTCL_PROBE_FIELD(OctreeHeader, leaf_count) RTCL_PROBE_FIELD(OctreeHeader, top_digits)
 
+RTCL_PROBE_RECORD(BlockBox)
+RTCL_PROBE_FIELD(BlockBox, bounds) RTCL_PROBE_FIELD(BlockBox, bounds[5])
 RTCL_PROBE_RECORD(OctreeNode)
 RTCL_PROBE_FIELD(OctreeNode, split) RTCL_PROBE_FIELD(OctreeNode, child) RTCL_PROBE_FIELD(OctreeNode, child[7])
 
 RTCL_PROBE_RECORD(OctreePtrHeader)
+RTCL_PROBE_FIELD(OctreePtrHeader, occupied_bounds) RTCL_PROBE_FIELD(OctreePtrHeader, occupied_bounds[5][7])
 RTCL_PROBE_FIELD(OctreePtrHeader, lower) RTCL_PROBE_FIELD(OctreePtrHeader, upper)
 RTCL_PROBE_FIELD(OctreePtrHeader, root) RTCL_PROBE_FIELD(OctreePtrHeader, leaf_count)
 RTCL_PROBE_FIELD(OctreePtrHeader, depth) RTCL_PROBE_FIELD(OctreePtrHeader, pad)

@@ -49,6 +49,36 @@ inline int8 intersect_box_rows8(global const float8* b, const TraceRay* s, float
   return tn <= tf;
 }
 
+/* Whether a slab test may rely on infinite slab distances for this ray:
+ * always at the robust and exact levels; at the fast level, compiled with
+ * -cl-fast-relaxed-math (which lets the compiler assume finite operands),
+ * only when the ray moves along every axis (finite reciprocals). A box
+ * test that may not answers "meets", which is conservative. */
+inline int rtcl_slabs_defined(const TraceRay* s) {
+#ifdef RTCL_PRECISION_FAST
+  return rtcl_is_finite(s->ix) && rtcl_is_finite(s->iy) && rtcl_is_finite(s->iz);
+#else
+  return 1;
+#endif
+}
+
+/* The ray over [tmin, tmax] against one box, six floats in the Bvh8Node
+ * bounds order (lower x, y, z, upper x, y, z): lane by lane the arithmetic
+ * of intersect_box_rows8. Returns whether the ray meets it (always, where
+ * rtcl_slabs_defined does not hold). */
+inline int intersect_box1(global const float* b, const TraceRay* s, float tmax) {
+  if (!rtcl_slabs_defined(s)) return 1;
+  float tn = fmax((b[s->near_x] - s->ox) * s->ix,
+                  fmax((b[s->near_y] - s->oy) * s->iy, fmax((b[s->near_z] - s->oz) * s->iz, s->tmin)));
+  float tf = fmin((b[s->far_x] - s->ox) * s->ix,
+                  fmin((b[s->far_y] - s->oy) * s->iy, fmin((b[s->far_z] - s->oz) * s->iz, tmax)));
+#ifndef RTCL_PRECISION_FAST
+  tn -= fabs(tn) * RTCL_SLAB_WIDEN;
+  tf += fabs(tf) * RTCL_SLAB_WIDEN;
+#endif
+  return tn <= tf;
+}
+
 /* The same for the eight child boxes of a BVH node. */
 inline int8 intersect_boxes8(global const Bvh8Node* node, const TraceRay* s, float tmax, float8* t_entry) {
   float8 t_exit;

@@ -144,9 +144,26 @@ typedef struct OctreeNode {
   rtcl_i32 child[8];
 } OctreeNode;
 
-/* The root of a pointer octree: its box, and the root reference (an inner
- * node index, or a leaf or empty reference as in OctreeNode). 48 bytes. */
+/* The box of one triangle block of an octree leaf (kernels/shared/octree.h:
+ * a ray that misses it skips the block's eight tests): the box of the
+ * block's triangles intersected with the leaf's cell widened as the
+ * build's overlap test widens it (octree_widening), in the Bvh8Node bounds
+ * order: lower x, y, z, upper x, y, z. Every hit of the block's triangles
+ * inside the widened cell lies in it. 24 bytes. */
+typedef struct BlockBox {
+  float bounds[6];
+} BlockBox;
+
+/* The root of a pointer octree: its box, the root reference (an inner
+ * node index, or a leaf or empty reference as in OctreeNode), and the
+ * occupied space: occupied_bounds (Bvh8Node bounds layout) holds, per child
+ * q of an inner root, the union of the BlockBoxes of the leaves below it
+ * and of their spheres' boxes clipped to their widened cells (empty slot:
+ * lower +inf, upper -inf); a leaf root has its box in slot 0 and the other
+ * slots empty. Every hit inside a leaf's widened cell lies in its
+ * octant's box. 240 bytes. */
 typedef struct OctreePtrHeader {
+  float occupied_bounds[6][RTCL_BLOCK_WIDTH]; /* first: float8 rows, 32-byte aligned */
   float lower[4];        /* [3] unused */
   float upper[4];        /* [3] unused */
   rtcl_i32 root;

@@ -26,12 +26,19 @@ inline int octree_clip_axis(float o, float d, float inv, float lower, float uppe
 /* Tests the blocks of leaf `leaf` (OctreeHeader / OctreeNode pair layout:
  * triangle blocks [leaf_begin[2l], leaf_begin[2l + 2]), sphere blocks
  * [leaf_begin[2l + 1], leaf_begin[2l + 3])) with the block tests brute force
- * runs (the same t, bit for bit). Returns 1 when an any-hit query is done. */
+ * runs (the same t, bit for bit); a triangle block whose BlockBox the ray
+ * misses before the best hit is skipped (its hits inside the widened cell
+ * lie in the box; a hit outside the cell is in another leaf of the block's
+ * triangle, which the walk reaches unless a nearer hit ends it). Returns 1
+ * when an any-hit query is done. */
 inline int octree_test_leaf(uint leaf, global const uint* leaf_begin, global const TriangleBlock* triangles,
-                            global const SphereBlock* spheres, const TraceRay* s, HitState* h) {
+                            global const SphereBlock* spheres, global const BlockBox* boxes, const TraceRay* s,
+                            HitState* h) {
   uint end = leaf_begin[2 * leaf + 2];
   for (uint b = leaf_begin[2 * leaf]; b < end; ++b)
-    if (intersect_triangles8(triangles + b, s, h) && RTCL_ANY_HIT) return 1;
+    if (intersect_box1(boxes[b].bounds, s, h->t_best) && intersect_triangles8(triangles + b, s, h) &&
+        RTCL_ANY_HIT)
+      return 1;
 #ifdef RTCL_HAS_SPHERES
   end = leaf_begin[2 * leaf + 3];
   for (uint b = leaf_begin[2 * leaf + 1]; b < end; ++b)

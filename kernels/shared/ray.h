@@ -158,6 +158,12 @@ inline float rtcl_min8(float8 a) {
   return fmin(m2.lo, m2.hi);
 }
 
+inline float rtcl_max8(float8 a) {
+  float4 m4 = fmax(a.lo, a.hi);
+  float2 m2 = fmax(m4.lo, m4.hi);
+  return fmax(m2.lo, m2.hi);
+}
+
 /* Index of the first lane of a that equals m (m is one of a's values). */
 inline int rtcl_lane_of(float8 a, float m) {
   int8 eq = a == (float8)(m);

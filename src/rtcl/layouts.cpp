@@ -21,7 +21,9 @@ static_assert(sizeof(GridHeader) == 272 && offsetof(GridHeader, occupied_bounds)
               offsetof(GridHeader, lane_stride) == 256);
 static_assert(sizeof(OctreeHeader) == 32 && offsetof(OctreeHeader, cell) == 16 && offsetof(OctreeHeader, top_digits) == 28);
 static_assert(sizeof(OctreeNode) == 48 && offsetof(OctreeNode, child) == 16);
-static_assert(sizeof(OctreePtrHeader) == 48 && offsetof(OctreePtrHeader, root) == 32);
+static_assert(sizeof(BlockBox) == 24);
+static_assert(sizeof(OctreePtrHeader) == 240 && offsetof(OctreePtrHeader, lower) == 192 &&
+              offsetof(OctreePtrHeader, root) == 224);
 static_assert(sizeof(KdNode) == 8 && offsetof(KdNode, data) == 4);
 static_assert(sizeof(KdHeader) == 32 && offsetof(KdHeader, upper) == 16);
 

@@ -28,7 +28,8 @@ int bucket_digits(std::size_t leaves, int depth) {
 
 std::size_t Octree::bytes() const {
   return sizeof(OctreeHeader) + codes.size() * sizeof(std::uint64_t) + leaf_begin.size() * sizeof(rtcl_u32) +
-         bucket_begin.size() * sizeof(rtcl_u32) + blocks.bytes();
+         bucket_begin.size() * sizeof(rtcl_u32) + blocks.bytes() +
+         block_boxes.size() * sizeof(BlockBox);
 }
 
 OctreeHeader octree_cube(const Geometry& geometry, int depth) {
@@ -113,10 +114,11 @@ Octree build_octree(const Geometry& geometry, const OctreeConfig& config) {
   out.codes.reserve(leaves.size());
   out.leaf_begin.reserve(2 * leaves.size() + 2);
   out.leaf_begin = {0, 0};
+  const double widening = octree_widening(geometry);
   out.ref_count = tree.ref_count;
   for (const auto& [code, i] : leaves) {
     out.codes.push_back(code);
-    append_leaf_blocks(geometry, tree.ids, tree.nodes[i].refs, out.blocks, out.leaf_begin);
+    append_leaf_blocks(geometry, tree.ids, tree.nodes[i], widening, out.blocks, out.block_boxes, out.leaf_begin);
     std::vector<rtcl_i32>().swap(tree.nodes[i].refs);
   }
   out.header.leaf_count = static_cast<rtcl_u32>(out.codes.size());
@@ -159,7 +161,8 @@ class OctreeAccel final : public Accel {
                                   "octree leaf offsets")),
         bucket_begin_(device.upload(tree.bucket_begin.data(), tree.bucket_begin.size() * sizeof(rtcl_u32),
                                     "octree buckets")),
-        primitives_(upload(device, tree.blocks)) {}
+        primitives_(upload(device, tree.blocks)),
+        block_boxes_(upload_block_boxes(device, tree.block_boxes)) {}
 
  private:
   static constexpr std::uint64_t kNoCode = 0;
@@ -171,10 +174,12 @@ class OctreeAccel final : public Accel {
     kernel.setArg(first + 3, bucket_begin_);
     kernel.setArg(first + 4, primitives_.triangles);
     kernel.setArg(first + 5, primitives_.spheres);
+    kernel.setArg(first + 6, block_boxes_);
   }
 
   cl::Buffer header_, codes_, leaf_begin_, bucket_begin_;
   DevicePrimitives primitives_;
+  cl::Buffer block_boxes_;
 };
 
 }  // namespace

@@ -44,6 +44,7 @@ struct Octree {
   std::vector<rtcl_u32> leaf_begin;       // 2 * (codes.size() + 1) block offsets (OctreeHeader)
   std::vector<rtcl_u32> bucket_begin;     // 8^top_digits + 1 table offsets
   PrimitiveBlocks blocks;                 // each leaf's own blocks (append_leaf_blocks)
+  std::vector<BlockBox> block_boxes;      // one per triangle block
   std::size_t ref_count = 0;              // primitive copies over all leaves
   std::size_t node_count = 0;             // inner nodes and leaves, empty ones too
   std::size_t bytes() const;              // everything the device holds

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <span>
 
 #include "rtcl/bounds/overlap.hpp"
 #include "rtcl/error.hpp"
@@ -97,16 +98,63 @@ double octree_padding(const Geometry& geometry) {
 }
 
 void append_leaf_blocks(const Geometry& geometry, const std::vector<std::uint32_t>& ids,
-                        const std::vector<rtcl_i32>& refs, PrimitiveBlocks& blocks,
-                        std::vector<rtcl_u32>& leaf_begin) {
+                        const OctreeBuildNode& node, double widening, PrimitiveBlocks& blocks,
+                        std::vector<BlockBox>& boxes, std::vector<rtcl_u32>& leaf_begin) {
   const std::uint32_t triangle_count = static_cast<std::uint32_t>(geometry.triangles.size());
   std::vector<std::uint32_t> triangles, spheres;
-  for (rtcl_i32 r : refs) (r >= 0 ? triangles : spheres).push_back(r >= 0 ? ids[r] : triangle_count + std::uint32_t(~r));
-  for (const std::vector<std::uint32_t>* kind : {&triangles, &spheres})
-    for (std::size_t k = 0; k < kind->size(); k += RTCL_BLOCK_WIDTH)
-      blocks.append(geometry, std::span(*kind).subspan(k, std::min<std::size_t>(RTCL_BLOCK_WIDTH, kind->size() - k)));
+  for (rtcl_i32 r : node.refs) (r >= 0 ? triangles : spheres).push_back(r >= 0 ? ids[r] : triangle_count + std::uint32_t(~r));
+  auto corner = [&](std::uint32_t id, int v) { return geometry.vertices[geometry.triangles[id][v]]; };
+  for (std::size_t k = 0; k < triangles.size(); k += RTCL_BLOCK_WIDTH) {
+    std::span<const std::uint32_t> block = std::span(triangles).subspan(k, std::min<std::size_t>(RTCL_BLOCK_WIDTH, triangles.size() - k));
+    blocks.append(geometry, block);
+    BlockBox box;
+    for (int a = 0; a < 3; ++a) {
+      float lo = INFINITY, hi = -INFINITY;
+      for (std::uint32_t id : block)
+        for (int v = 0; v < 3; ++v) {
+          lo = std::min(lo, corner(id, v)[a]);
+          hi = std::max(hi, corner(id, v)[a]);
+        }
+      // the widened cell, rounded outwards to float
+      float cell_lo = std::nextafter(static_cast<float>(double(node.lower[a]) - widening), -INFINITY);
+      float cell_hi = std::nextafter(static_cast<float>(double(node.upper[a]) + widening), INFINITY);
+      box.bounds[a] = std::max(lo, cell_lo);
+      box.bounds[3 + a] = std::min(hi, cell_hi);
+    }
+    boxes.push_back(box);
+  }
+  for (std::size_t k = 0; k < spheres.size(); k += RTCL_BLOCK_WIDTH)
+    blocks.append(geometry, std::span(spheres).subspan(k, std::min<std::size_t>(RTCL_BLOCK_WIDTH, spheres.size() - k)));
   leaf_begin.push_back(static_cast<rtcl_u32>(blocks.triangles.size()));
   leaf_begin.push_back(static_cast<rtcl_u32>(blocks.spheres.size()));
+}
+
+BlockBox leaf_sphere_box(const Geometry& geometry, const OctreeBuildNode& node, double widening) {
+  BlockBox box{{INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY}};
+  for (rtcl_i32 r : node.refs) {
+    if (r >= 0) continue;
+    const Sphere& s = geometry.spheres[std::size_t(~r)];
+    for (int a = 0; a < 3; ++a) {
+      double lo = std::max(double(s.center[a]) - double(s.radius), double(node.lower[a]) - widening);
+      double hi = std::min(double(s.center[a]) + double(s.radius), double(node.upper[a]) + widening);
+      box.bounds[a] = std::min(box.bounds[a], std::nextafter(static_cast<float>(lo), -INFINITY));
+      box.bounds[3 + a] = std::max(box.bounds[3 + a], std::nextafter(static_cast<float>(hi), INFINITY));
+    }
+  }
+  return box;
+}
+
+void grow_box(BlockBox& box, const BlockBox& other) {
+  for (int a = 0; a < 3; ++a) {
+    box.bounds[a] = std::min(box.bounds[a], other.bounds[a]);
+    box.bounds[3 + a] = std::max(box.bounds[3 + a], other.bounds[3 + a]);
+  }
+}
+
+cl::Buffer upload_block_boxes(const Device& device, const std::vector<BlockBox>& boxes) {
+  static const BlockBox none{};
+  return boxes.empty() ? device.upload(&none, sizeof none, "octree block boxes")
+                       : device.upload(boxes.data(), boxes.size() * sizeof(BlockBox), "octree block boxes");
 }
 
 std::vector<OptionSpec> octree_options(int max_depth, int depth, std::size_t leaf_size, double ref_budget,

@@ -107,14 +107,27 @@ OctreeBuild build_octree_nodes(const Geometry& geometry, const std::array<float,
                                const std::array<float, 3>& upper, const OctreeBuildConfig& config,
                                int max_depth_limit, const OctreeSplitRule& rule);
 
-// Appends the primitives of one leaf (`refs`, ascending: triangles then
-// spheres; `ids` = OctreeBuild::ids) to `blocks` as blocks of its own, eight
-// to a block, ids ascending, and then the new ends of the triangle and
-// sphere block arrays to `leaf_begin` (the pair layout of
-// OctreeHeader / OctreeNode leaves).
+// Appends the primitives of leaf `node` (its refs, ascending: triangles
+// then spheres; `ids` = OctreeBuild::ids) to `blocks` as blocks of its own,
+// eight to a block, ids ascending (so that a tie between two of its
+// primitives goes to the lower id, as in brute force), and then the new
+// ends of the triangle and sphere block arrays to `leaf_begin` (the pair
+// layout of OctreeHeader / OctreeNode leaves). Each triangle block gets its
+// BlockBox in `boxes` (the node's cell widened by `widening`,
+// octree_widening).
 void append_leaf_blocks(const Geometry& geometry, const std::vector<std::uint32_t>& ids,
-                        const std::vector<rtcl_i32>& refs, PrimitiveBlocks& blocks,
-                        std::vector<rtcl_u32>& leaf_begin);
+                        const OctreeBuildNode& node, double widening, PrimitiveBlocks& blocks,
+                        std::vector<BlockBox>& boxes, std::vector<rtcl_u32>& leaf_begin);
+
+// The box of leaf `node`'s spheres clipped to its cell widened by
+// `widening` (empty, lower +inf and upper -inf, when it has none), and the
+// union of two boxes.
+BlockBox leaf_sphere_box(const Geometry& geometry, const OctreeBuildNode& node, double widening);
+void grow_box(BlockBox& box, const BlockBox& other);
+
+// The boxes on the device; a one-box placeholder where there is none, so
+// that the kernel signature never changes.
+cl::Buffer upload_block_boxes(const Device& device, const std::vector<BlockBox>& boxes);
 
 // The options every octree declares (depth, leaf_size, ref_budget), with
 // these defaults and depth range [0, max_depth], then `extra`.

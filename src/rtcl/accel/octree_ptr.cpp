@@ -1,6 +1,8 @@
 #include "rtcl/accel/octree_ptr.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "rtcl/accel/octree.hpp"
 #include "rtcl/error.hpp"
@@ -9,7 +11,7 @@ namespace rtcl {
 
 std::size_t OctreePtr::bytes() const {
   return sizeof(OctreePtrHeader) + nodes.size() * sizeof(OctreeNode) + leaf_begin.size() * sizeof(rtcl_u32) +
-         blocks.bytes();
+         blocks.bytes() + block_boxes.size() * sizeof(BlockBox);
 }
 
 OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const std::array<float, 3>& lower,
@@ -22,6 +24,15 @@ OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const
   out.header.depth = tree.depth;
   out.ref_count = tree.ref_count;
   out.leaf_begin = {0, 0};
+  const double widening = octree_widening(geometry);
+  for (int r = 0; r < 6; ++r)
+    for (int q = 0; q < RTCL_BLOCK_WIDTH; ++q) out.header.occupied_bounds[r][q] = r < 3 ? INFINITY : -INFINITY;
+  // The root's child each node lies below (slot 0 for a leaf root); build
+  // order puts parents first.
+  std::vector<int> octant(tree.nodes.size(), 0);
+  for (std::size_t i = 0; i < tree.nodes.size(); ++i)
+    if (!tree.nodes[i].leaf())
+      for (int q = 0; q < 8; ++q) octant[static_cast<std::size_t>(tree.nodes[i].child[q])] = i == 0 ? q : octant[i];
   // Build order (breadth first) keeps parents before children: an inner
   // node's index is its rank among the inner nodes, so one pass numbers them.
   std::vector<rtcl_i32> reference(tree.nodes.size());
@@ -37,7 +48,14 @@ OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const
       continue;
     }
     reference[i] = ~static_cast<rtcl_i32>(out.leaf_begin.size() / 2 - 1);
-    append_leaf_blocks(geometry, tree.ids, node.refs, out.blocks, out.leaf_begin);
+    const std::size_t first_box = out.block_boxes.size();
+    append_leaf_blocks(geometry, tree.ids, node, widening, out.blocks, out.block_boxes, out.leaf_begin);
+    BlockBox content = leaf_sphere_box(geometry, node, widening);
+    for (std::size_t b = first_box; b < out.block_boxes.size(); ++b) grow_box(content, out.block_boxes[b]);
+    for (int r = 0; r < 6; ++r) {
+      float& v = out.header.occupied_bounds[r][octant[i]];
+      v = r < 3 ? std::min(v, content.bounds[r]) : std::max(v, content.bounds[r]);
+    }
     std::vector<rtcl_i32>().swap(node.refs);
   }
   out.nodes.resize(static_cast<std::size_t>(inner));
@@ -86,7 +104,8 @@ class OctreePtrAccel final : public Accel {
                                                   "octree nodes")),
         leaf_begin_(device.upload(tree.leaf_begin.data(), tree.leaf_begin.size() * sizeof(rtcl_u32),
                                   "octree leaf offsets")),
-        primitives_(upload(device, tree.blocks)) {}
+        primitives_(upload(device, tree.blocks)),
+        block_boxes_(upload_block_boxes(device, tree.block_boxes)) {}
 
  private:
   static constexpr OctreeNode kNoNode{};
@@ -96,10 +115,12 @@ class OctreePtrAccel final : public Accel {
     kernel.setArg(first + 2, leaf_begin_);
     kernel.setArg(first + 3, primitives_.triangles);
     kernel.setArg(first + 4, primitives_.spheres);
+    kernel.setArg(first + 5, block_boxes_);
   }
 
   cl::Buffer header_, nodes_, leaf_begin_;
   DevicePrimitives primitives_;
+  cl::Buffer block_boxes_;
 };
 
 }  // namespace

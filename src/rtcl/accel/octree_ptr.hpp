@@ -39,7 +39,8 @@ struct OctreePtr {
   // and sphere blocks [leaf_begin[2l + 1], leaf_begin[2l + 3]); 2 * (leaves
   // + 1) entries.
   std::vector<rtcl_u32> leaf_begin;
-  PrimitiveBlocks blocks;           // each leaf's own copies, ids ascending
+  PrimitiveBlocks blocks;           // each leaf's own copies (append_leaf_blocks)
+  std::vector<BlockBox> block_boxes; // one per triangle block
   std::size_t ref_count = 0;        // primitive copies over all leaves
   std::size_t bytes() const;
 };
