@@ -2,6 +2,7 @@
 // temporary directory, and checks exit codes, messages and output files.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -71,6 +72,7 @@ TEST(CliErrors, UsageErrorsAreOneLineAndExit2) {
   expect_usage_error(run_cli(in.dir, {"trace", "--frobnicate"}), "unknown option '--frobnicate'");
   expect_usage_error(run_cli(in.dir, with(trace, {"extra"})), "unexpected argument 'extra'");
   expect_usage_error(run_cli(in.dir, {"trace", in.mesh}), "RAYS is required");
+  expect_usage_error(run_cli(in.dir, with(trace, {"--repeat", "0"})), "--repeat: Value 0 not in range");
   expect_usage_error(run_cli(in.dir, {"no-such-command"}), "unexpected argument 'no-such-command'");
   EXPECT_FALSE(std::filesystem::exists(in.dir.file("out.hits")));
   EXPECT_FALSE(std::filesystem::exists(in.dir.file("x.png")));
@@ -126,6 +128,31 @@ TEST(Cli, TraceMatchesTheReference) {
       EXPECT_GT(hit_count, in.ray_list.size() / 4) << "the rays aim at the mesh";
     }
   }
+}
+
+// --repeat N: N warm launches, their min / median / max times in order, and
+// the answers of the last still the reference's.
+TEST(Cli, RepeatedTraceReportsMinMedianMaxAndMatchesTheReference) {
+  Inputs in;
+  Geometry g = load_mesh(in.mesh).geometry;
+  CliRun run = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits", "--repeat", "5"});
+  ASSERT_EQ(run.status, 0) << run.err;
+  std::size_t at = run.out.find(": min ");
+  ASSERT_NE(at, std::string::npos) << run.out;
+  double lo = 0, mid = 0, hi = 0;
+  unsigned launches = 0;
+  ASSERT_EQ(std::sscanf(run.out.c_str() + at, ": min %lf / median %lf / max %lf ms over %u warm launches", &lo, &mid,
+                        &hi, &launches),
+            4)
+      << run.out;
+  EXPECT_EQ(launches, 5u);
+  EXPECT_LE(lo, mid);
+  EXPECT_LE(mid, hi);
+  std::vector<Hit> hits = read_hits(in.dir.file("out.hits"));
+  ASSERT_EQ(hits.size(), in.ray_list.size());
+  std::size_t failures = 0;
+  auto report = judge_all(g, in.ray_list, hits, Query::closest, &failures);
+  EXPECT_EQ(failures, 0u) << (report.empty() ? "" : report[0]);
 }
 
 // --coherent: the default structure traces 8-ray packets; the answers stay

@@ -28,6 +28,7 @@ struct TraceOptions {
   std::string precision = "robust";
   bool any = false;
   bool coherent = false;
+  int repeat = 1;  // timed launches; above 1, after one warm-up launch
 };
 
 using Clock = std::chrono::steady_clock;
@@ -37,12 +38,15 @@ double ms_since(Clock::time_point start) {
 }
 
 struct TraceResult {
-  double trace_ms = 0.0;
-  bool profiled = false;  // trace_ms from OpenCL event times, not the host clock
+  std::vector<double> trace_ms;  // per timed launch, ascending
+  bool profiled = false;         // from OpenCL event times, not the host clock
 };
 
+// `repeat` timed launches of the same query (after one untimed warm-up
+// launch, which absorbs PoCL's code generation, when repeat > 1); the hits
+// are those of the last.
 TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query,
-                            Coherence coherence, const std::string& rays_path) {
+                            Coherence coherence, const std::string& rays_path, int repeat) {
   TraceResult result;
   if (rays.empty()) return result;
   const Device& device = accel.device();
@@ -50,20 +54,29 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
   cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), ray_what.c_str());
   cl::Buffer hit_buffer = device.allocate(hits.size() * sizeof(Hit), hit_what.c_str(), CL_MEM_WRITE_ONLY);
   with_cl_errors([&] {
-    Clock::time_point start = Clock::now();
-    cl::Event done = accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence);
-    done.wait();
-    result.trace_ms = ms_since(start);
-    if (device.profiling()) {
-      cl_ulong begin = done.getProfilingInfo<CL_PROFILING_COMMAND_START>();
-      cl_ulong end = done.getProfilingInfo<CL_PROFILING_COMMAND_END>();
-      result.trace_ms = static_cast<double>(end - begin) * 1e-6;
-      result.profiled = true;
+    if (repeat > 1) accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence).wait();
+    result.profiled = device.profiling();
+    for (int r = 0; r < repeat; ++r) {
+      Clock::time_point start = Clock::now();
+      cl::Event done = accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence);
+      done.wait();
+      double ms = ms_since(start);
+      if (result.profiled) {
+        cl_ulong begin = done.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+        cl_ulong end = done.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+        ms = static_cast<double>(end - begin) * 1e-6;
+      }
+      result.trace_ms.push_back(ms);
     }
+    std::sort(result.trace_ms.begin(), result.trace_ms.end());
     device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data());
   });
   return result;
 }
+
+// Rays per microsecond; a timer that reads 0 for a tiny launch gives no rate
+// rather than inf.
+double mrays_per_s(std::size_t rays, double ms) { return ms > 0.0 ? static_cast<double>(rays) / (ms * 1e3) : 0.0; }
 
 void run_trace(const TraceOptions& options) {
   std::string accel_name = accel_or_default(options.accel);
@@ -107,17 +120,25 @@ void run_trace(const TraceOptions& options) {
   Query query = options.any ? Query::any : Query::closest;
   Coherence coherence = options.coherent ? Coherence::coherent : Coherence::incoherent;
   std::vector<Hit> hits(rays.size());
-  TraceResult traced = trace_on_device(*accel, rays, hits, query, coherence, options.rays);
+  TraceResult traced = trace_on_device(*accel, rays, hits, query, coherence, options.rays, options.repeat);
   const char* kind = options.any ? "any hit (occlusion)" : "closest hit";
   std::size_t per_item = accel->rays_per_work_item(coherence);
   std::string traversal = per_item == 1 ? "one ray per work-item" : std::to_string(per_item) + "-ray packets";
   if (rays.empty()) {
     std::printf("trace:  %s: no rays\n", kind);
+  } else if (traced.trace_ms.size() == 1) {
+    double ms = traced.trace_ms[0];
+    std::printf("trace:  %s, %s: %.3f ms (%s), %.2f Mrays/s\n", kind, traversal.c_str(), ms,
+                traced.profiled ? "OpenCL event profiling" : "host clock", mrays_per_s(rays.size(), ms));
   } else {
-    // A timer that reads 0 for a tiny launch gives no rate rather than inf.
-    double mrays = traced.trace_ms > 0.0 ? static_cast<double>(rays.size()) / (traced.trace_ms * 1e3) : 0.0;
-    std::printf("trace:  %s, %s: %.3f ms (%s), %.2f Mrays/s\n", kind, traversal.c_str(), traced.trace_ms,
-                traced.profiled ? "OpenCL event profiling" : "host clock", mrays);
+    const std::vector<double>& ms = traced.trace_ms;
+    double median = ms.size() % 2 ? ms[ms.size() / 2] : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]);
+    std::printf(
+        "trace:  %s, %s: min %.3f / median %.3f / max %.3f ms over %zu warm launches (%s), %.2f / %.2f / %.2f "
+        "Mrays/s\n",
+        kind, traversal.c_str(), ms.front(), median, ms.back(), ms.size(),
+        traced.profiled ? "OpenCL event profiling" : "host clock", mrays_per_s(rays.size(), ms.back()),
+        mrays_per_s(rays.size(), median), mrays_per_s(rays.size(), ms.front()));
   }
   std::size_t hit_count = std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.prim >= 0; });
   write_hits(options.hits, hits);
@@ -143,6 +164,11 @@ void add_trace_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--device", options->device,
                   "OpenCL device: index or name substring from `rtcl devices` (default: $RTCL_DEVICE, else 0)");
+  cmd->add_option("--repeat", options->repeat,
+                  "launch the query N times after one warm-up launch and print the min / median / max kernel time "
+                  "(as the benchmarks measure it); the hit file holds the last launch's answers")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
   cmd->add_flag("--any", options->any, "occlusion query: report any hit in [tmin, tmax], not the closest");
   cmd->add_flag("--coherent", options->coherent,
                 "the rays come in coherent packets: each consecutive group of 8 (rays 0-7, 8-15, ...) has nearby "
