@@ -10,6 +10,7 @@
 
 #include "ray_sets.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/scene/procedural.hpp"
 #include "rtcl/render/ray_order.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 
@@ -118,23 +119,6 @@ class Oracle {
   std::unique_ptr<Accel> accel_;
 #endif
 };
-
-// Appends a closed box around the geometry, `scale` times its largest side
-// (12 triangles facing inwards).
-void add_stadium(Geometry& g, float scale) {
-  Aabb box = g.bounds();
-  glm::vec3 extent = box.extent();
-  float half = 0.5f * scale * std::max({extent.x, extent.y, extent.z});
-  glm::vec3 c = box.center();
-  auto first = static_cast<std::uint32_t>(g.vertices.size());
-  for (int i = 0; i < 8; ++i)
-    g.vertices.push_back(c + half * glm::vec3(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f));
-  const std::uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    g.triangles.push_back(glm::uvec3(first + q[0], first + q[1], first + q[2]));
-    g.triangles.push_back(glm::uvec3(first + q[0], first + q[2], first + q[3]));
-  }
-}
 
 std::shared_ptr<const BenchScene> load_scene(const SceneSpec& spec) {
   auto scene = std::make_shared<BenchScene>();
