@@ -23,6 +23,6 @@ static_assert(sizeof(OctreeHeader) == 32 && offsetof(OctreeHeader, cell) == 16 &
 static_assert(sizeof(OctreeNode) == 48 && offsetof(OctreeNode, child) == 16);
 static_assert(sizeof(OctreePtrHeader) == 48 && offsetof(OctreePtrHeader, root) == 32);
 static_assert(sizeof(KdNode) == 8 && offsetof(KdNode, data) == 4);
-static_assert(sizeof(KdHeader) == 32 && offsetof(KdHeader, upper) == 16);
+static_assert(sizeof(KdHeader) == 48 && offsetof(KdHeader, upper) == 16 && offsetof(KdHeader, lane_stride) == 32);
 
 }  // namespace rtcl
