@@ -25,8 +25,8 @@ struct KdTreeConfig {
   // Only the ratio of the two costs matters (Mitsuba uses 15 and 20). With
   // batch = 8 (below), 15 was the best of 10, 15 and 20 on the primary rays
   // of the bunny, sponza and sibenik (README, "BSP and kd-tree": bench
-  // sweep/<scene>/<kind>/kdtree/batch=8,ct=...); with batch = 1, 30 was
-  // the best of 10..120 on the bunny's.
+  // sweep/<scene>/<kind>/kdtree/ct=...); with batch = 1 (sweep
+  // .../kdtree/batch=1,ct=...), 30 was the best of 10..120 on the bunny's.
   double traversal_cost = 15.0;
   double intersection_cost = 20.0;
   // The empty-space bonus in [0, 1) (Wald & Havran's 0.8 factor = 0.2):
