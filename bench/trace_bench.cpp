@@ -206,7 +206,8 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
   if (spec.name == "dragon") return;
   std::vector<std::string> specs;
   for (const char* ct : {"ct=5", "ct=10", "ct=15", "ct=20", "ct=40", "batch=1,ct=10", "batch=1,ct=15", "batch=1,ct=30",
-                         "batch=1,ct=60", "batch=1,ct=120", "batch=1,ct=240", "batch=4,ct=15", "batch=4,ct=30"})
+                         "batch=1,ct=60", "batch=1,ct=120", "batch=1,ct=240", "batch=4,ct=15", "batch=4,ct=30", "empty=0",
+                         "empty=0.5", "empty=0.8"})
     specs.push_back(std::string("kdtree:") + ct);
   for (const char* o : {"depth=14", "depth=18", "depth=22", "depth=26", "leaf=2", "leaf=12"}) specs.push_back(std::string("bsp:") + o);
   for (RayKind kind : {RayKind::primary, RayKind::diffuse})
