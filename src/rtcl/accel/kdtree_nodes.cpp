@@ -161,6 +161,10 @@ KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const
     too_large(what, option, std::to_string(tree.refs.size()) + " references", tree.refs.size() * sizeof(rtcl_i32),
               max_alloc_bytes);
   const std::size_t stride = tree.refs.size() + kLanePadding;
+  // The kernel indexes a lane row as row * lane_stride in int.
+  if (9 * stride > static_cast<std::size_t>(std::numeric_limits<rtcl_i32>::max()))
+    throw Error(what + ": " + option + ": " + std::to_string(tree.refs.size()) +
+                " references, more than the reference lanes' 32-bit indices hold");
   if (max_alloc_bytes && 9 * stride * sizeof(float) > max_alloc_bytes)
     too_large(what, option, std::to_string(tree.refs.size()) + " reference lanes", 9 * stride * sizeof(float),
               max_alloc_bytes);

@@ -101,8 +101,8 @@ struct KdBuildNode {
 // Flattens the build tree into the device layout. Throws Error naming the
 // structure and its options (`option`, e.g. "depth=20") when the tree is
 // deeper than kKdMaxDepth, when a node or reference index needs more than
-// 30 bits, or when nodes, references or the reference lanes exceed
-// max_alloc_bytes (0: none).
+// 30 bits or the reference lanes more than 2^31 floats, or when nodes,
+// references or the reference lanes exceed max_alloc_bytes (0: none).
 KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const std::string& structure,
                        const std::string& option, std::size_t max_alloc_bytes);
 
