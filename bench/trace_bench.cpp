@@ -7,7 +7,7 @@
 //     with that option (lambda=..., res=AxBxC, macro=...): the lecture's
 //     trade-off of cell count against list length, and the macrocell size
 //     (bench/plot_sweep.py plots it)
-//   sweep/<scene>/<kind>/kdtree/ct=<value>, sweep/<scene>/<kind>/bsp/<option>=<value>
+//   sweep/<scene>/<kind>/kdtree/[batch=<b>,]ct=<value>, sweep/<scene>/<kind>/bsp/<option>=<value>
 //     the kd-tree's SAH traversal cost, the BSP's depth and leaf size
 // Kernel time comes from OpenCL event profiling (COMMAND_START .. COMMAND_END)
 // and is reported as manual time; a warm-up launch first absorbs PoCL's
@@ -199,13 +199,15 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
           ->Unit(benchmark::kMillisecond);
 });
 
-// The kd-tree's SAH traversal cost (intersection cost 20) and the BSP's
+// The kd-tree's SAH traversal cost (intersection cost 20; the default
+// batch = 8, and the classic batch = 1) and the BSP's
 // depth and leaf size, on the ray kinds below; README "BSP and kd-tree".
 [[maybe_unused]] const bool kd_sweep_registered = add_scene_hook([](const SceneSpec& spec) {
   if (spec.name == "dragon") return;
   std::vector<std::string> specs;
-  for (const char* ct : {"ct=10", "ct=15", "ct=30", "ct=60", "ct=120", "batch=8,ct=5", "batch=8,ct=10",
-                         "batch=8,ct=20", "batch=4,ct=15"})
+  for (const char* ct : {"ct=5", "ct=10", "ct=15", "ct=20", "ct=40", "batch=1,ct=10", "batch=1,ct=15", "batch=1,ct=30",
+                         "batch=1,ct=60", "batch=1,ct=120", "batch=1,ct=240", "batch=4,ct=15", "batch=4,ct=30", "empty=0",
+                         "empty=0.5", "empty=0.8"})
     specs.push_back(std::string("kdtree:") + ct);
   for (const char* o : {"depth=14", "depth=18", "depth=22", "depth=26", "leaf=2", "leaf=12"}) specs.push_back(std::string("bsp:") + o);
   for (RayKind kind : {RayKind::primary, RayKind::diffuse})

@@ -100,12 +100,19 @@ Geometry soup_and_spheres(std::size_t triangles, std::uint32_t seed) {
 
 TEST(KdTrace, MatchesBruteForceOnSoupsAndSplitPlaneRays) {
   Geometry g = soup_and_spheres(600, 5);
-  KdTree t = build_kdtree(g);
-  std::vector<Ray> rays = random_rays(g, 600, 6);
-  std::vector<Ray> planes = split_plane_rays(t, 7, 1200);
-  rays.insert(rays.end(), planes.begin(), planes.end());
-  for (Precision level : test_precisions())
-    expect_same_as_brute(*make_kdtree(test_device(), g, {}, AccelConfig{level, {}}), g, rays, level);
+  // The default costs (leaves of up to a few runs of 8) and the classic SAH
+  // (a cost per primitive: a deeper tree of small leaves, more planes).
+  KdTreeConfig classic;
+  classic.batch = 1;
+  classic.traversal_cost = 30.0;
+  for (const KdTreeConfig& config : {KdTreeConfig{}, classic}) {
+    KdTree t = build_kdtree(g, config);
+    std::vector<Ray> rays = random_rays(g, 600, 6);
+    std::vector<Ray> planes = split_plane_rays(t, 7, 1200);
+    rays.insert(rays.end(), planes.begin(), planes.end());
+    for (Precision level : test_precisions())
+      expect_same_as_brute(*make_kdtree(test_device(), g, config, AccelConfig{level, {}}), g, rays, level);
+  }
 }
 
 TEST(KdTrace, MatchesBruteForceOnTheBunny) {

@@ -32,9 +32,11 @@
  * rounding of dist and of the interval ends; the intervals themselves are
  * split at the computed dist.
  *
- * Leaves: the references are tested in batches of eight
- * (intersect_triangle_refs / intersect_sphere_refs: the arithmetic of brute
- * force, so the same t bit for bit). The closest hit so far stays a
+ * Leaves: the triangles are tested from the reference lanes (KdNode) in
+ * contiguous runs of up to eight (intersect_triangle_run: float8 loads, no
+ * gather; sphere positions are NaN and never hit), the spheres gathered by
+ * reference in batches of eight (intersect_sphere_refs): the arithmetic of
+ * brute force, so the same t bit for bit. The closest hit so far stays a
  * candidate even when it lies beyond the leaf's interval (a primitive
  * extending into later leaves is then not closer when met again). Early
  * exit: a subtree on the stack is skipped when the candidate lies before
@@ -81,20 +83,19 @@ inline int kd_clip_axis(float o, float d, float inv, float lower, float upper, f
 #define KD_EMPTY(node) (((node).flags & 3u) == RTCL_KD_LEAF && (node).data == 0u)
 
 /* Tests a leaf's references refs[first .. end) (triangles, then spheres as
- * ~r), eight at a time. Returns 1 when a hit ends an any-hit query. */
-inline int kd_test_leaf(global const int* refs, uint first, uint end, global const TriangleBlock* triangles,
-                        global const SphereBlock* spheres, const TraceRay* s, HitState* h) {
+ * ~r): the triangles' lanes in runs of eight, the spheres in batches of
+ * eight. Returns 1 when a hit ends an any-hit query. */
+inline int kd_test_leaf(global const int* refs, uint first, uint end, global const float* lanes, int lane_stride,
+                        global const int* lane_prims, global const SphereBlock* spheres, const TraceRay* s,
+                        HitState* h) {
+  for (uint k = first; k < end; k += 8)
+    if (intersect_triangle_run(lanes, lane_stride, lane_prims, k, (int)min(end - k, 8u), s, h) && RTCL_ANY_HIT)
+      return 1;
+#ifdef RTCL_HAS_SPHERES
   int batch[8];
   int count = 0;
   uint k = first;
-  for (; k < end && refs[k] >= 0; ++k) {
-    batch[count++] = refs[k];
-    if (count == 8 || k + 1 == end || refs[k + 1] < 0) {
-      if (intersect_triangle_refs(triangles, batch, count, s, h) && RTCL_ANY_HIT) return 1;
-      count = 0;
-    }
-  }
-#ifdef RTCL_HAS_SPHERES
+  while (k < end && refs[k] >= 0) ++k;
   for (; k < end; ++k) {
     batch[count++] = ~refs[k];
     if (count == 8 || k + 1 == end) {
@@ -108,8 +109,9 @@ inline int kd_test_leaf(global const int* refs, uint first, uint end, global con
 
 __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, global const KdHeader* header,
                                                global const KdNode* nodes, global const int* refs,
-                                               global const TriangleBlock* triangles,
+                                               global const float* lanes, global const int* lane_prims,
                                                global const SphereBlock* spheres) {
+  const int lane_stride = header->lane_stride;
   float t_min = s->tmin, t_max = s->tmax;
   if (!kd_clip_axis(s->ox, s->dx, s->ix, header->lower[0], header->upper[0], &t_min, &t_max)) return;
   if (!kd_clip_axis(s->oy, s->dy, s->iy, header->lower[1], header->upper[1], &t_min, &t_max)) return;
@@ -171,7 +173,7 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
       axis = node.flags & 3u;
     }
     uint first = node.flags >> 2;
-    if (kd_test_leaf(refs, first, first + node.data, triangles, spheres, s, h)) return;
+    if (kd_test_leaf(refs, first, first + node.data, lanes, lane_stride, lane_prims, spheres, s, h)) return;
     /* The next subtree whose interval may still hold a nearer hit. */
     do {
       if (top == 0) return;
@@ -185,6 +187,6 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
 
 #define KD_PARAMS                                                                            \
   global const KdHeader *header, global const KdNode *nodes, global const int *refs,       \
-      global const TriangleBlock *triangles, global const SphereBlock *spheres
-#define KD_ARGS header, nodes, refs, triangles, spheres
+      global const float *lanes, global const int *lane_prims, global const SphereBlock *spheres
+#define KD_ARGS header, nodes, refs, lanes, lane_prims, spheres
 RTCL_TRACE_KERNELS(kdtree, KD_PARAMS, KD_ARGS)

@@ -180,7 +180,12 @@ typedef struct OctreePtrHeader {
  * data holds the split coordinate's float bits. Leaf: its references are
  * refs[(flags >> 2) .. (flags >> 2) + data), triangles first as r >= 0 (lane
  * r & 7 of triangle block r >> 3, id-ordered blocks), then spheres as ~r < 0,
- * each kind in ascending order. Every index is < 2^30. */
+ * each kind in ascending order. Every index is < 2^30. Reference lanes (a
+ * leaf's triangles load as contiguous float8 runs, as GridHeader's): row
+ * 3 * vertex + axis of a float array with rows KdHeader.lane_stride apart
+ * holds, at position k, that coordinate of the triangle of refs[k] (NaN
+ * where refs[k] is a sphere, and in the 8 positions past the last
+ * reference), and lane_prims[k] its primitive id (-1 there). */
 typedef struct KdNode {
   rtcl_u32 flags;
   rtcl_u32 data;
@@ -190,11 +195,14 @@ typedef struct KdNode {
 #define RTCL_KD_LEAF_NODE(first) (RTCL_KD_LEAF | ((rtcl_u32)(first) << 2))
 
 /* The tree's root box [lower, upper] (closed, float), which contains every
- * stored primitive; traversal clips the ray to it. 32 bytes; element [3] of
- * each row is unused. */
+ * stored primitive; traversal clips the ray to it; and the rows' stride of
+ * the reference lanes (KdNode). 48 bytes; element [3] of each row is
+ * unused. */
 typedef struct KdHeader {
   float lower[4];
   float upper[4];
+  rtcl_i32 lane_stride; /* references + 8 */
+  rtcl_i32 unused[3];
 } KdHeader;
 
 #ifndef __OPENCL_VERSION__

@@ -25,6 +25,6 @@ static_assert(sizeof(BlockBox) == 24);
 static_assert(sizeof(OctreePtrHeader) == 240 && offsetof(OctreePtrHeader, lower) == 192 &&
               offsetof(OctreePtrHeader, root) == 224);
 static_assert(sizeof(KdNode) == 8 && offsetof(KdNode, data) == 4);
-static_assert(sizeof(KdHeader) == 32 && offsetof(KdHeader, upper) == 16);
+static_assert(sizeof(KdHeader) == 48 && offsetof(KdHeader, upper) == 16 && offsetof(KdHeader, lane_stride) == 32);
 
 }  // namespace rtcl

@@ -22,20 +22,23 @@ struct KdTreeConfig {
   //   traversal_cost + intersection_cost * (SA_L / SA * N_L + SA_R / SA * N_R),
   // times (1 - empty_bonus) when one side is empty; a leaf costs
   // intersection_cost * N, and a node whose best split costs more is a leaf.
-  // Only the ratio of the two costs matters. Mitsuba uses 15 and 20; on
-  // PoCL a node step is dearer relative to a test (README, "BSP and
-  // kd-tree": bench sweep/<scene>/<kind>/kdtree/ct=...), 30 was the best
-  // of 10..120 on the bunny's primary rays.
-  double traversal_cost = 30.0;
+  // Only the ratio of the two costs matters (Mitsuba uses 15 and 20). With
+  // batch = 8 (below), 15 was the best of 10, 15 and 20 on the primary rays
+  // of the bunny, sponza and sibenik (README, "BSP and kd-tree": bench
+  // sweep/<scene>/<kind>/kdtree/ct=...); with batch = 1 (sweep
+  // .../kdtree/batch=1,ct=...), 30 was the best of 10..120 on the bunny's.
+  double traversal_cost = 15.0;
   double intersection_cost = 20.0;
   // The empty-space bonus in [0, 1) (Wald & Havran's 0.8 factor = 0.2):
   // favours splits that cut off empty space, which the interval traversal
   // skips for the price of one node.
   double empty_bonus = 0.2;
   // Primitives one intersection test covers in the cost model, 1..8: 1 is
-  // the classic SAH (cost per primitive); the kernel tests a leaf in
-  // batches of 8 float8 lanes, where 1 and 8 triangles cost the same.
-  unsigned batch = 1;
+  // the classic SAH (cost per primitive); the kernel tests a leaf's
+  // contiguous reference lanes in runs of 8 float8 lanes, where 1 and 8
+  // triangles cost the same, so 8 models it: larger leaves, a shallower
+  // tree, fewer references, a faster build.
+  unsigned batch = 8;
   // Host threads (0 = hardware concurrency) for subtrees of nodes with at
   // least 4096 primitives, and for sorting the root's events per axis.
   unsigned thread_count = 0;

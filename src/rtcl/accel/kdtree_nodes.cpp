@@ -16,6 +16,9 @@ namespace {
 
 // Node and reference indices share a 32-bit word with the 2 axis bits.
 constexpr std::size_t kMaxIndex = std::size_t(1) << 30;
+// Positions past the last reference lane: a float8 run starting at the last
+// reference stays inside its row.
+constexpr std::size_t kLanePadding = RTCL_BLOCK_WIDTH;
 
 [[noreturn]] void too_large(const std::string& structure, const std::string& option, const std::string& what,
                             std::uint64_t bytes, std::size_t limit) {
@@ -66,7 +69,9 @@ float kd_round_float(double x, bool down) {
 }
 
 std::size_t KdTree::bytes() const {
-  return sizeof(KdHeader) + nodes.size() * sizeof(KdNode) + refs.size() * sizeof(rtcl_i32) + blocks.bytes();
+  return sizeof(KdHeader) + nodes.size() * sizeof(KdNode) + refs.size() * sizeof(rtcl_i32) +
+         lanes.size() * sizeof(float) + lane_prims.size() * sizeof(rtcl_i32) +
+         blocks.spheres.size() * sizeof(SphereBlock);
 }
 
 double KdTree::references_per_primitive() const {
@@ -155,7 +160,26 @@ KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const
   if (max_alloc_bytes && tree.refs.size() * sizeof(rtcl_i32) > max_alloc_bytes)
     too_large(what, option, std::to_string(tree.refs.size()) + " references", tree.refs.size() * sizeof(rtcl_i32),
               max_alloc_bytes);
+  const std::size_t stride = tree.refs.size() + kLanePadding;
+  // The kernel indexes a lane row as row * lane_stride in int.
+  if (9 * stride > static_cast<std::size_t>(std::numeric_limits<rtcl_i32>::max()))
+    throw Error(what + ": " + option + ": " + std::to_string(tree.refs.size()) +
+                " references, more than the reference lanes' 32-bit indices hold");
+  if (max_alloc_bytes && 9 * stride * sizeof(float) > max_alloc_bytes)
+    too_large(what, option, std::to_string(tree.refs.size()) + " reference lanes", 9 * stride * sizeof(float),
+              max_alloc_bytes);
   tree.blocks = in_order_blocks(*prims.geometry, prims.ids);
+  tree.header.lane_stride = static_cast<rtcl_i32>(stride);
+  tree.lanes.assign(9 * stride, std::numeric_limits<float>::quiet_NaN());
+  tree.lane_prims.assign(stride, -1);
+  for (std::size_t k = 0; k < tree.refs.size(); ++k) {
+    rtcl_i32 r = tree.refs[k];
+    if (r < 0) continue;
+    const TriangleBlock& b = tree.blocks.triangles[static_cast<std::size_t>(r) >> 3];
+    for (int v = 0; v < 3; ++v)
+      for (int a = 0; a < 3; ++a) tree.lanes[(3 * v + a) * stride + k] = b.v[v][a][r & 7];
+    tree.lane_prims[k] = b.prim[r & 7];
+  }
   return tree;
 }
 
@@ -178,7 +202,11 @@ class KdAccel final : public Accel {
         refs_(tree.refs.empty() ? device.upload(&kNoRef, sizeof kNoRef, (name + " references").c_str())
                                 : device.upload(tree.refs.data(), tree.refs.size() * sizeof(rtcl_i32),
                                                 (name + " references").c_str())),
-        primitives_(upload(device, tree.blocks)) {}
+        lanes_(device.upload(tree.lanes.data(), tree.lanes.size() * sizeof(float),
+                             (name + " reference lanes").c_str())),
+        lane_prims_(device.upload(tree.lane_prims.data(), tree.lane_prims.size() * sizeof(rtcl_i32),
+                                  (name + " reference lane ids").c_str())),
+        primitives_(upload(device, PrimitiveBlocks{{}, tree.blocks.spheres})) {}
 
  private:
   static constexpr rtcl_i32 kNoRef = 0;
@@ -193,11 +221,12 @@ class KdAccel final : public Accel {
     kernel.setArg(first, header_);
     kernel.setArg(first + 1, nodes_);
     kernel.setArg(first + 2, refs_);
-    kernel.setArg(first + 3, primitives_.triangles);
-    kernel.setArg(first + 4, primitives_.spheres);
+    kernel.setArg(first + 3, lanes_);
+    kernel.setArg(first + 4, lane_prims_);
+    kernel.setArg(first + 5, primitives_.spheres);
   }
 
-  cl::Buffer header_, nodes_, refs_;
+  cl::Buffer header_, nodes_, refs_, lanes_, lane_prims_;
   DevicePrimitives primitives_;
 };
 

@@ -32,7 +32,13 @@ struct KdTree {
   KdHeader header{};
   std::vector<KdNode> nodes;      // depth-first, root first
   std::vector<rtcl_i32> refs;     // leaf reference lists
-  PrimitiveBlocks blocks;         // stored primitives in id order (in_order_blocks)
+  // Reference lanes (KdNode): 9 rows of header.lane_stride floats, and the
+  // primitive id of each position; what the kernel tests triangles from.
+  std::vector<float> lanes;
+  std::vector<rtcl_i32> lane_prims;
+  // Stored primitives in id order (in_order_blocks); only the sphere
+  // blocks go to the device (the triangles are in the lanes).
+  PrimitiveBlocks blocks;
   std::uint32_t depth = 0;        // inner nodes on the longest root-to-leaf path
   std::size_t leaf_count = 0;
   std::size_t bytes() const;      // everything the device holds
@@ -95,7 +101,8 @@ struct KdBuildNode {
 // Flattens the build tree into the device layout. Throws Error naming the
 // structure and its options (`option`, e.g. "depth=20") when the tree is
 // deeper than kKdMaxDepth, when a node or reference index needs more than
-// 30 bits, or when nodes or references exceed max_alloc_bytes (0: none).
+// 30 bits or the reference lanes more than 2^31 floats, or when nodes,
+// references or the reference lanes exceed max_alloc_bytes (0: none).
 KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const std::string& structure,
                        const std::string& option, std::size_t max_alloc_bytes);
 
