@@ -1,5 +1,5 @@
 /* Every record, field and size convention that crosses the host/device
- * boundary (kernels/shared/layouts.h, kernels/shared/render_layouts.h), in
+ * boundary (kernels/shared/layouts.h, render_layouts.h, bounds_layouts.h), in
  * one list read by both kernels/probe/layout_probe.cl and
  * tests/layout_probe_test.cpp, which define the three entry kinds:
  *   RTCL_PROBE_RECORD(T)          sizeof(T) and the stride of a T array
@@ -106,3 +106,12 @@ RTCL_PROBE_VALUE(RTCL_SCAN_CHUNK)
 RTCL_PROBE_VALUE(RTCL_TILE)
 RTCL_PROBE_VALUE(rtcl_tile_order_pixel(77u, 13u, 11u))
 RTCL_PROBE_VALUE(rtcl_hash(12345u))
+
+RTCL_PROBE_RECORD(SlabVolume)
+RTCL_PROBE_FIELD(SlabVolume, normal) RTCL_PROBE_FIELD(SlabVolume, normal[12][3])
+RTCL_PROBE_FIELD(SlabVolume, d_near) RTCL_PROBE_FIELD(SlabVolume, d_far) RTCL_PROBE_FIELD(SlabVolume, d_far[15])
+RTCL_PROBE_FIELD(SlabVolume, reach) RTCL_PROBE_FIELD(SlabVolume, count)
+RTCL_PROBE_RECORD(SphereVolume)
+RTCL_PROBE_FIELD(SphereVolume, cx) RTCL_PROBE_FIELD(SphereVolume, r) RTCL_PROBE_FIELD(SphereVolume, reach)
+RTCL_PROBE_VALUE(RTCL_MAX_SLABS)
+RTCL_PROBE_VALUE(RTCL_SLAB_ROW)
