@@ -65,6 +65,32 @@ glm::dmat3 orthonormalised(glm::dmat3 b) {
   return b;
 }
 
+// The points extreme (smallest or largest projection) along 258 directions
+// spread over the sphere (a Fibonacci spiral): the hull vertices that matter
+// most to a box's faces, a few hundred instead of every vertex. The fit
+// refines on these; the final extents are taken over every point.
+std::vector<glm::vec3> support_points(const std::vector<glm::vec3>& points) {
+  constexpr int directions = 129;  // each gives its minimum and maximum
+  if (points.size() <= 2 * directions) return points;
+  std::vector<char> keep(points.size(), 0);
+  for (int k = 0; k < directions; ++k) {
+    double z = 1.0 - (2.0 * k + 1.0) / directions, r = std::sqrt(1.0 - z * z), phi = 2.399963229728653 * k;
+    glm::dvec3 n(r * std::cos(phi), r * std::sin(phi), z);
+    std::size_t lo = 0, hi = 0;
+    double dlo = std::numeric_limits<double>::infinity(), dhi = -dlo;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      double d = glm::dot(n, glm::dvec3(points[i]));
+      if (d < dlo) dlo = d, lo = i;
+      if (d > dhi) dhi = d, hi = i;
+    }
+    keep[lo] = keep[hi] = 1;
+  }
+  std::vector<glm::vec3> out;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (keep[i]) out.push_back(points[i]);
+  return out;
+}
+
 }  // namespace
 
 glm::vec3 Obb::half_extent() const {
@@ -114,9 +140,14 @@ Obb obb_of_points(const std::vector<glm::vec3>& points, const std::string& sourc
     cov += glm::outerProduct(d, d);
   }
   glm::dmat3 pca = orthonormalised(symmetric_eigen(cov).vectors);
-  Fit a = refine(points, evaluate(points, pca));
-  Fit b = refine(points, evaluate(points, glm::dmat3(1.0)));
-  const Fit& best = b.area <= a.area ? b : a;
+  std::vector<glm::vec3> support = support_points(points);
+  // Candidates measured on every point: the two refined starts and the
+  // world axes themselves (so the result is never larger than the AABB).
+  Fit best = evaluate(points, glm::dmat3(1.0));
+  for (const glm::dmat3& start : {pca, glm::dmat3(1.0)}) {
+    Fit f = evaluate(points, refine(support, evaluate(support, start)).basis);
+    if (f.area < best.area) best = f;
+  }
 
   Obb obb;
   for (int k = 0; k < 3; ++k) obb.axis[k] = glm::vec3(best.basis[k]);

@@ -4,12 +4,15 @@
 // Fit: the start is the principal axes of the points' covariance (PCA of the
 // point set itself, not of its convex hull: no hull is built, so dense
 // regions pull the axes; the refinement below corrects that) and, as a
-// second start, the world axes. Each start is refined by coordinate descent
+// second start, the world axes. Each start is refined, on the points that
+// are extreme along 129 directions spread over the sphere (at most 258 of
+// them; the final extents are taken over all points), by coordinate descent
 // over rotations about its own three axes, with steps from 0.25 rad halved
 // down to 1e-5 rad, accepting a rotation only when it lowers the box's
 // surface area (the quantity a random ray's hit probability is proportional
-// to, and well defined for flat inputs, where every box has volume 0). The
-// smaller result is kept, so the OBB's area never exceeds the AABB's.
+// to, and well defined for flat inputs, where every box has volume 0). Of
+// the two refined boxes and the AABB, measured on all points, the one with
+// the smallest area is kept, so the OBB's area never exceeds the AABB's.
 // Bounded: at most 64 sweeps per step size.
 #pragma once
 
