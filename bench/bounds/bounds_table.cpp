@@ -100,7 +100,7 @@ int main(int argc, char** argv) {
     }
   }
   for (const auto& c : rtcl::test::random_clouds(cloud_points, 42))
-    rows.push_back(measure(c.name + " (" + std::to_string(cloud_points) + ")", c.points, nullptr, 0));
+    rows.push_back(measure(c.name, c.points, nullptr, 0));
 
   const std::vector<BoundEntry>& first = rows.front().report.entries;
   std::printf("### Volume relative to the AABB\n\n| points |");
@@ -148,7 +148,12 @@ int main(int argc, char** argv) {
   for (const Row& r : rows) {
     if (r.reject.empty()) continue;
     std::printf("| %s | %zu |", r.name.c_str(), r.candidate_rays);
-    for (double x : r.reject) std::printf(" %.3f |", x);
+    for (double x : r.reject) {
+      if (r.candidate_rays == 0)
+        std::printf(" n/a |");
+      else
+        std::printf(" %.3f |", x);
+    }
     std::printf("\n");
   }
   return 0;
