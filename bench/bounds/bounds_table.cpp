@@ -130,6 +130,26 @@ int main(int argc, char** argv) {
     std::printf("| %s | %.6g | %.6g | %.6g | %.4f | %.4f |\n", r.name.c_str(), r.report.ritter.radius,
                 r.report.iterated.radius, e, r.report.ritter.radius / e, r.report.iterated.radius / e);
   }
+  // The Ritter / exact ratio over many seeds of each cloud shape (one seed
+  // above): the spread, not one draw.
+  constexpr int seeds = 25;
+  std::printf("\n### Ritter / exact radius over %d seeds per cloud (%zu points)\n\n"
+              "| cloud | min | median | max | iterated / exact, max |\n|---|---|---|---|---|\n",
+              seeds, cloud_points);
+  for (std::size_t shape = 0; shape < 4; ++shape) {
+    std::vector<double> ratio, iterated;
+    std::string name;
+    for (int seed = 0; seed < seeds; ++seed) {
+      rtcl::test::PointCloud c = rtcl::test::random_clouds(cloud_points, 1000u + 7u * seed)[shape];
+      name = c.name;
+      double exact = exact_sphere(c.points, c.name).radius;
+      ratio.push_back(ritter_sphere(c.points, c.name).radius / exact);
+      iterated.push_back(iterated_ritter_sphere(c.points, c.name).radius / exact);
+    }
+    std::sort(ratio.begin(), ratio.end());
+    std::printf("| %s | %.4f | %.4f | %.4f | %.4f |\n", name.c_str(), ratio.front(), ratio[ratio.size() / 2],
+                ratio.back(), *std::max_element(iterated.begin(), iterated.end()));
+  }
   std::printf("\n### Build time, ms (host, one thread)\n\n| points |");
   for (const BoundEntry& e : first) std::printf(" %s |", e.name.c_str());
   std::printf("\n|---|");
