@@ -30,6 +30,10 @@ RTCL_PROBE_RECORD(Bvh8Node)
 RTCL_PROBE_FIELD(Bvh8Node, bounds) RTCL_PROBE_FIELD(Bvh8Node, bounds[3][0])
 RTCL_PROBE_FIELD(Bvh8Node, bounds[5][7]) RTCL_PROBE_FIELD(Bvh8Node, child)
 
+RTCL_PROBE_RECORD(Bvh8Spheres)
+RTCL_PROBE_FIELD(Bvh8Spheres, cx) RTCL_PROBE_FIELD(Bvh8Spheres, cy) RTCL_PROBE_FIELD(Bvh8Spheres, cz)
+RTCL_PROBE_FIELD(Bvh8Spheres, r) RTCL_PROBE_FIELD(Bvh8Spheres, r[7])
+
 RTCL_PROBE_RECORD(GridHeader)
 RTCL_PROBE_FIELD(GridHeader, lower) RTCL_PROBE_FIELD(GridHeader, cell) RTCL_PROBE_FIELD(GridHeader, res)
 RTCL_PROBE_FIELD(GridHeader, res[2]) RTCL_PROBE_FIELD(GridHeader, macro)
