@@ -45,11 +45,12 @@ const StructureSpec& bvh_mixed_structure() {
     StructureSpec s{"bvh-mixed", "the bvh with a per-node choice of boxes alone or boxes then bounding spheres "
                                  "(expected cost, surface-area based); one ray per work-item",
                     bvh_sah_options()};
-    s.options.push_back({"sphere_cost", OptionType::real, 1.0, 0, 64, false,
-                         "cost of a node's eight-sphere filter relative to its eight-box test: 0 puts spheres "
-                         "wherever they are smaller than the box, large values none"});
-    s.options.push_back({"block_cost", OptionType::real, 4.0, 0, 64, false,
-                         "cost of one leaf block (eight triangle tests) relative to a node's box test"});
+    s.options.push_back({"sphere_cost", OptionType::real, double{VolumeCosts{}.sphere}, 0, 64, false,
+                         "cost of a node's eight-sphere filter relative to its eight-box test (measured on PoCL: "
+                         "1.36); 0 puts spheres wherever they are smaller than the box, large values none"});
+    s.options.push_back({"block_cost", OptionType::real, double{VolumeCosts{}.block}, 0, 64, false,
+                         "cost of one leaf block (eight triangle tests) relative to a node's box test (measured "
+                         "on PoCL: 8.1)"});
     return s;
   }();
   return spec;
