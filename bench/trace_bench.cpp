@@ -199,6 +199,19 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
           ->Unit(benchmark::kMillisecond);
 });
 
+// The mixed-volume BVH's sphere-filter cost (README "Bounding volumes"):
+// 0 puts a sphere filter wherever a sphere is smaller than its box; the
+// plain BVH of the same run is trace/<scene>/<kind>/bvh.
+[[maybe_unused]] const bool mixed_sweep_registered = add_scene_hook([](const SceneSpec& spec) {
+  for (RayKind kind : ray_kinds)
+    for (const char* cost : {"0", "0.25"})
+      benchmark::RegisterBenchmark(
+          ("sweep/" + spec.name + "/" + ray_kind_name(kind) + "/bvh-mixed/sphere_cost=" + cost).c_str(),
+          trace_benchmark, spec.name, kind, std::string("bvh-mixed:sphere_cost=") + cost)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond);
+});
+
 // The kd-tree's SAH traversal cost (intersection cost 20; the default
 // batch = 8, and the classic batch = 1) and the BSP's
 // depth and leaf size, on the ray kinds below; README "BSP and kd-tree".

@@ -20,8 +20,21 @@
  * with a constant lane index (extracted from registers) beat bit-mask
  * iteration, a branch-free compaction and a float8 sorting network; the
  * traversal stays a separate function (its private arrays stay on the
- * native stack instead of becoming per-work-item arrays). */
+ * native stack instead of becoming per-work-item arrays).
+ *
+ * Mixed volumes (RTCL_BVH_SPHERES, the "bvh-mixed" structure): nodes with
+ * sphere_of[node] >= 0 also filter the children their boxes let through by
+ * the bounding spheres of record sphere_of[node] (shared/sphere_filter8.h).
+ * Without the define the kernel has no sphere code and no extra arguments. */
 #include "shared/trace.h"
+#ifdef RTCL_BVH_SPHERES
+#include "shared/sphere_filter8.h"
+#define BVH_SPHERE_PARAMS , global const int *sphere_of, global const Bvh8Spheres *sphere_filters
+#define BVH_SPHERE_ARGS , sphere_of, sphere_filters
+#else
+#define BVH_SPHERE_PARAMS
+#define BVH_SPHERE_ARGS
+#endif
 
 #ifndef RTCL_STACK_SIZE
 #define RTCL_STACK_SIZE 64
@@ -29,7 +42,11 @@
 
 __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
                                             global const TriangleBlock* triangles,
-                                            global const SphereBlock* spheres) {
+                                            global const SphereBlock* spheres BVH_SPHERE_PARAMS) {
+#ifdef RTCL_BVH_SPHERES
+  SphereFilterRay filter;
+  sphere_filter_setup(s, &filter);
+#endif
   int stack_ref[RTCL_STACK_SIZE];
   float stack_t[RTCL_STACK_SIZE]; /* entry distance of stack_ref's box */
   int sp = 0;
@@ -39,6 +56,10 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
       global const Bvh8Node* node = nodes + ref;
       float8 t_entry;
       int8 hit = intersect_boxes8(node, s, h->t_best, &t_entry);
+#ifdef RTCL_BVH_SPHERES
+      int filter_ref = sphere_of[ref];
+      if (filter_ref >= 0 && rtcl_any8(hit)) hit &= sphere_filter8(sphere_filters + filter_ref, s, &filter);
+#endif
       if (rtcl_any8(hit)) {
         int base = sp;
         /* insertion into [base, sp) kept sorted by decreasing distance */
@@ -75,7 +96,8 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
   }
 }
 
-#define BVH_PARAMS \
-  global const Bvh8Node *nodes, global const TriangleBlock *triangles, global const SphereBlock *spheres
-#define BVH_ARGS nodes, triangles, spheres
+#define BVH_PARAMS                                                                                    \
+  global const Bvh8Node *nodes, global const TriangleBlock *triangles, global const SphereBlock *spheres \
+      BVH_SPHERE_PARAMS
+#define BVH_ARGS nodes, triangles, spheres BVH_SPHERE_ARGS
 RTCL_TRACE_KERNELS(bvh, BVH_PARAMS, BVH_ARGS)

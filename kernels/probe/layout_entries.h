@@ -1,5 +1,5 @@
 /* Every record, field and size convention that crosses the host/device
- * boundary (kernels/shared/layouts.h, kernels/shared/render_layouts.h), in
+ * boundary (kernels/shared/layouts.h, render_layouts.h, bounds_layouts.h), in
  * one list read by both kernels/probe/layout_probe.cl and
  * tests/layout_probe_test.cpp, which define the three entry kinds:
  *   RTCL_PROBE_RECORD(T)          sizeof(T) and the stride of a T array
@@ -29,6 +29,10 @@ RTCL_PROBE_FIELD(SphereBlock, r) RTCL_PROBE_FIELD(SphereBlock, prim)
 RTCL_PROBE_RECORD(Bvh8Node)
 RTCL_PROBE_FIELD(Bvh8Node, bounds) RTCL_PROBE_FIELD(Bvh8Node, bounds[3][0])
 RTCL_PROBE_FIELD(Bvh8Node, bounds[5][7]) RTCL_PROBE_FIELD(Bvh8Node, child)
+
+RTCL_PROBE_RECORD(Bvh8Spheres)
+RTCL_PROBE_FIELD(Bvh8Spheres, cx) RTCL_PROBE_FIELD(Bvh8Spheres, cy) RTCL_PROBE_FIELD(Bvh8Spheres, cz)
+RTCL_PROBE_FIELD(Bvh8Spheres, r) RTCL_PROBE_FIELD(Bvh8Spheres, r[7])
 
 RTCL_PROBE_RECORD(GridHeader)
 RTCL_PROBE_FIELD(GridHeader, lower) RTCL_PROBE_FIELD(GridHeader, cell) RTCL_PROBE_FIELD(GridHeader, res)
@@ -110,3 +114,12 @@ RTCL_PROBE_VALUE(RTCL_SCAN_CHUNK)
 RTCL_PROBE_VALUE(RTCL_TILE)
 RTCL_PROBE_VALUE(rtcl_tile_order_pixel(77u, 13u, 11u))
 RTCL_PROBE_VALUE(rtcl_hash(12345u))
+
+RTCL_PROBE_RECORD(SlabVolume)
+RTCL_PROBE_FIELD(SlabVolume, normal) RTCL_PROBE_FIELD(SlabVolume, normal[12][3])
+RTCL_PROBE_FIELD(SlabVolume, d_near) RTCL_PROBE_FIELD(SlabVolume, d_far) RTCL_PROBE_FIELD(SlabVolume, d_far[15])
+RTCL_PROBE_FIELD(SlabVolume, reach) RTCL_PROBE_FIELD(SlabVolume, count)
+RTCL_PROBE_RECORD(SphereVolume)
+RTCL_PROBE_FIELD(SphereVolume, cx) RTCL_PROBE_FIELD(SphereVolume, r) RTCL_PROBE_FIELD(SphereVolume, reach)
+RTCL_PROBE_VALUE(RTCL_MAX_SLABS)
+RTCL_PROBE_VALUE(RTCL_SLAB_ROW)

@@ -61,6 +61,17 @@ typedef struct Bvh8Node {
   rtcl_i32 child[RTCL_BLOCK_WIDTH];
 } Bvh8Node;
 
+/* Bounding-sphere filters of the eight children of one node of the
+ * mixed-volume BVH (src/rtcl/accel/bvh_volumes.hpp, kernels/accel/bvh.cl
+ * with RTCL_BVH_SPHERES): centre x, y, z and a radius already widened by
+ * the ray-independent part of the rounding margin (kernels/shared/
+ * sphere_filter8.h); r < 0 marks a lane without a sphere (its box alone
+ * decides). 128 bytes, so every record starts on a float8 boundary. */
+typedef struct Bvh8Spheres {
+  float cx[RTCL_BLOCK_WIDTH], cy[RTCL_BLOCK_WIDTH], cz[RTCL_BLOCK_WIDTH];
+  float r[RTCL_BLOCK_WIDTH];
+} Bvh8Spheres;
+
 /* Child references: >= 0 is an inner node index; RTCL_CHILD_EMPTY is an empty
  * slot; any other negative c is a leaf with ref = ~c (>= 0): ref >> 1 indexes
  * a TriangleBlock when (ref & 1) == 0, else a SphereBlock. */

@@ -15,6 +15,7 @@ static_assert(sizeof(TriangleBlock) == 320 && offsetof(TriangleBlock, prim) == 2
 static_assert(sizeof(SphereBlock) == 160 && offsetof(SphereBlock, r) == 96 && offsetof(SphereBlock, prim) == 128);
 static_assert(sizeof(Bvh8Node) == 224 && offsetof(Bvh8Node, child) == 192);
 static_assert(sizeof(Bvh8Node) % 32 == 0, "nodes must start on float8 boundaries");
+static_assert(sizeof(Bvh8Spheres) == 128 && offsetof(Bvh8Spheres, cz) == 64 && offsetof(Bvh8Spheres, r) == 96);
 static_assert(sizeof(GridHeader) == 272 && offsetof(GridHeader, occupied_bounds) == 0 &&
               offsetof(GridHeader, lower) == 192 && offsetof(GridHeader, cell) == 208 &&
               offsetof(GridHeader, res) == 224 && offsetof(GridHeader, macro) == 240 &&

@@ -347,6 +347,12 @@ BvhConfig bvh_config(const StructureSpec& structure, const AccelConfig& config) 
 
 }  // namespace
 
+const std::vector<OptionSpec>& bvh_sah_options() { return sah_options(); }
+
+BvhConfig resolve_bvh_config(const StructureSpec& structure, const AccelConfig& config) {
+  return bvh_config(structure, config);
+}
+
 const StructureSpec& bvh_structure() {
   static const StructureSpec spec{"bvh", "8-wide BVH, top-down binned SAH; packets of 8 rays for coherent calls",
                                   sah_options()};

@@ -87,6 +87,12 @@ std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size);
 std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config = {},
                                 std::string name = "bvh", const AccelConfig& accel_config = {});
 
+// The options of the SAH-built structures ("bvh", "bvh-packet"), and the
+// BvhConfig a structure's resolved options give (for structures built on
+// the BVH, bvh_mixed.hpp).
+const std::vector<OptionSpec>& bvh_sah_options();
+BvhConfig resolve_bvh_config(const StructureSpec& structure, const AccelConfig& config);
+
 // Their registry entries; the options set the SahConfig / PlocConfig fields
 // of the same name and BvhConfig::merge_leaves.
 const StructureSpec& bvh_structure();

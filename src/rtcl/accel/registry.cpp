@@ -7,6 +7,7 @@
 #include "rtcl/accel/brute.hpp"
 #include "rtcl/accel/bsp.hpp"
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/bvh_mixed.hpp"
 #include "rtcl/accel/grid.hpp"
 #include "rtcl/accel/octree.hpp"
 #include "rtcl/accel/octree_ptr.hpp"
@@ -31,6 +32,7 @@ const std::vector<Entry>& registry() {
       {bvh_structure(), make_bvh_sah},
       {bvh_ploc_structure(), make_bvh_ploc},
       {bvh_packet_structure(), make_bvh_packet},
+      {bvh_mixed_structure(), make_bvh_mixed},
       {grid_structure(), make_grid_accel},
       {octree_structure(), make_octree_accel},
       {octree_ptr_structure(), make_octree_ptr_accel},

@@ -1,0 +1,20 @@
+// "bvh-mixed": the binned-SAH 8-wide BVH of "bvh" with a per-node choice of
+// bounding volume (bvh_volumes.hpp): boxes alone, or boxes then bounding
+// spheres. Traced one ray per work-item (kernels/accel/bvh.cl, compiled
+// with RTCL_BVH_SPHERES only when some node has spheres), for coherent
+// calls too: the packet kernel has no sphere filter.
+#pragma once
+
+#include <memory>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel/bvh_volumes.hpp"
+
+namespace rtcl {
+
+// Options: those of "bvh", plus sphere_cost and block_cost (VolumeCosts).
+const StructureSpec& bvh_mixed_structure();
+
+std::unique_ptr<Accel> make_bvh_mixed(const Device& device, const Geometry& geometry, const AccelConfig& config);
+
+}  // namespace rtcl
