@@ -11,5 +11,6 @@ void add_devices_command(CLI::App& app);
 void add_trace_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_structures_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 }  // namespace rtcl::cli
