@@ -7,6 +7,7 @@
 #include <string>
 
 #include "rtcl/error.hpp"
+#include "rtcl/scene/orthonormal_basis.hpp"
 #include "rtcl/shared/render_layouts.h"  // rtcl_hash
 
 namespace rtcl::bench {
@@ -21,23 +22,12 @@ Ray make_ray(const glm::vec3& o, const glm::vec3& d, float tmin, float tmax) {
 
 float unit_float(std::uint32_t bits) { return static_cast<float>(bits >> 8) * 0x1p-24f; }  // [0, 1)
 
-// Two tangents completing a unit normal n to an orthonormal basis, without a
-// branch on the normal's direction (Duff et al., "Building an Orthonormal
-// Basis, Revisited", JCGT 2017).
-void tangents(const glm::vec3& n, glm::vec3& t1, glm::vec3& t2) {
-  float sign = std::copysign(1.0f, n.z);
-  float a = -1.0f / (sign + n.z);
-  float b = n.x * n.y * a;
-  t1 = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-  t2 = glm::vec3(b, sign + n.y * n.y * a, -n.y);
-}
-
 // Cosine-weighted direction about n (Malley's method: a uniform point on the
 // unit disc lifted to the hemisphere).
 glm::vec3 cosine_direction(const glm::vec3& n, float u1, float u2) {
   float r = std::sqrt(u1), phi = 6.28318530718f * u2;
   glm::vec3 t1, t2;
-  tangents(n, t1, t2);
+  orthonormal_basis(n, t1, t2);
   glm::vec3 d = r * std::cos(phi) * t1 + r * std::sin(phi) * t2 + std::sqrt(std::max(0.0f, 1.0f - u1)) * n;
   return glm::normalize(d);
 }
