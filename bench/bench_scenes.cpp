@@ -36,37 +36,6 @@ Query ray_kind_query(RayKind kind) {
   return kind == RayKind::shadow || kind == RayKind::shadow_morton ? Query::any : Query::closest;
 }
 
-// Cameras and lights, in each file's own units and axes (all four are y-up).
-// bunny (0.16 units, faces +z) and dragon (14 units long, side view from +z):
-// seen from the front, the model filling most of the square view. sponza:
-// from the floor at one end of the atrium looking along it (x axis); sibenik:
-// from the entrance end of the nave towards the apse (+x). teapot-stadium:
-// the teapot from the front and above, inside its stadium.
-const std::vector<SceneSpec>& scene_specs() {
-  static const std::vector<SceneSpec> specs = {
-      {"bunny", "stanford_bunny/bunny.obj",
-       {{-0.0168f, 0.110f, 0.36f}, {-0.0168f, 0.110f, -0.0015f}, {0, 1, 0}, 30.0f},
-       {0.15f, 0.35f, 0.30f}},
-      {"dragon", "stanford_dragon_100k/dragon.obj",
-       {{0.0f, 5.5f, 28.0f}, {0.0f, 4.97f, 0.0f}, {0, 1, 0}, 30.0f},
-       {-10.0f, 20.0f, 20.0f}},
-      {"sponza", "sponza/sponza.obj",
-       {{13.0f, 2.0f, 0.0f}, {-10.0f, 4.0f, 0.0f}, {0, 1, 0}, 60.0f},
-       {0.0f, 13.0f, 1.0f}},
-      {"sibenik", "sibenik/sibenik.obj",
-       {{-17.0f, -11.0f, 0.0f}, {0.0f, -9.0f, 0.0f}, {0, 1, 0}, 60.0f},
-       {-2.0f, -3.0f, 0.0f}},
-      // The teapot (6.4 units wide) in a box 100 times its size; the camera
-      // sees it and the far walls around it.
-      {"teapot-stadium", "teapot/teapot.obj",
-       {{0.0f, 4.0f, 10.0f}, {0.2f, 1.4f, 0.0f}, {0, 1, 0}, 50.0f},
-       {5.0f, 10.0f, 8.0f},
-       100.0f,
-       16384},
-  };
-  return specs;
-}
-
 namespace {
 
 long env_number(const char* name, long fallback, long lowest) {
@@ -136,7 +105,7 @@ std::shared_ptr<const BenchScene> load_scene(const SceneSpec& spec) {
   scene->oracle = oracle.name();
   scene->primary.rays = primary_rays(spec.camera, scene->width, scene->height);
   scene->primary.reference = oracle.trace(Query::closest, scene->primary.rays);
-  SecondaryRays secondary = secondary_rays(scene->geometry, scene->primary, spec.light);
+  SecondaryRays secondary = secondary_rays(scene->geometry, scene->primary.rays, scene->primary.reference, spec.light);
   scene->shadow.rays = std::move(secondary.shadow);
   scene->diffuse.rays = std::move(secondary.diffuse);
   scene->shadow.reference = oracle.trace(Query::any, scene->shadow.rays);
@@ -209,7 +178,7 @@ std::shared_ptr<const BenchScene> bench_scene(const std::string& name) {
   std::lock_guard lock(mutex);
   if (resident && resident->spec->name == name) return resident;
   const auto& specs = scene_specs();
-  auto spec = std::find_if(specs.begin(), specs.end(), [&](const SceneSpec& s) { return s.name == name; });
+  auto spec = std::find_if(specs.begin(), specs.end(), [&](const SceneSpec& s) { return s.name == name && !s.fit; });
   if (spec == specs.end()) throw Error("benchmark scene '" + name + "' is not defined in scene_specs()");
   resident.reset();  // release the previous scene before loading the next
   resident = load_scene(*spec);
@@ -254,8 +223,11 @@ bool add_scene_hook(SceneHook hook) {
 }
 
 void register_scene_benchmarks() {
+  // Only the scenes with placed cameras (scene_specs() lists fitted ones
+  // too, for `rtcl bench`).
   for (const SceneSpec& spec : scene_specs())
-    for (const SceneHook& hook : hooks()) hook(spec);
+    if (!spec.fit)
+      for (const SceneHook& hook : hooks()) hook(spec);
 }
 
 }  // namespace rtcl::bench

@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "rtcl/accel/accel.hpp"
+#include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/scene/geometry.hpp"
@@ -36,29 +37,7 @@ inline constexpr RayKind ordered_ray_kinds[] = {RayKind::primary_tiled, RayKind:
 const char* ray_kind_name(RayKind kind);
 Query ray_kind_query(RayKind kind);
 
-// Pinhole camera; square image, vertical field of view in degrees.
-struct Camera {
-  glm::vec3 eye, target, up;
-  float fov_y_deg;
-};
-
-struct SceneSpec {
-  std::string name;  // as it appears in benchmark names: trace/<name>/...
-  std::string file;  // relative to scenes_dir()
-  Camera camera;
-  glm::vec3 light;   // point light position, scene units
-  // > 0: the mesh stands inside a closed box (12 triangles) this many times
-  // its largest side, centred on it: the "teapot in a stadium", a scene
-  // whose primitives fill a tiny part of its box.
-  float stadium = 0.0f;
-  // > 0: the grid (trace/ and sweep/) traces a subset, every k-th ray, at
-  // most this many, as brute force does: where it is up to ~250x slower than the
-  // BVH (the teapot in its stadium) a full set would take minutes a launch.
-  std::size_t grid_ray_limit = 0;
-};
-
-// bunny, dragon, sponza, sibenik, teapot-stadium, in that order.
-const std::vector<SceneSpec>& scene_specs();
+// Camera, SceneSpec and scene_specs(): rtcl/bench/scene_catalog.hpp.
 
 // $RTCL_SCENES_DIR, else the ../shared/scenes beside the source tree.
 std::string scenes_dir();

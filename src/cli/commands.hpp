@@ -12,5 +12,6 @@ void add_trace_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_structures_command(CLI::App& app);
 void add_bounds_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 }  // namespace rtcl::cli

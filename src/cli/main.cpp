@@ -1,4 +1,4 @@
-// rtcl: list OpenCL devices, trace ray files, render scenes.
+// rtcl: list OpenCL devices, trace ray files, render scenes, benchmark.
 #include <cstdio>
 
 #include "cli_errors.hpp"
@@ -13,6 +13,7 @@ int main(int argc, char** argv) {
   rtcl::cli::add_render_command(app);
   rtcl::cli::add_structures_command(app);
   rtcl::cli::add_bounds_command(app);
+  rtcl::cli::add_bench_command(app);
   if (argc < 2) {  // no subcommand: show what there is, and fail
     std::fputs(app.help().c_str(), stderr);
     return static_cast<int>(rtcl::cli::ExitCode::usage);

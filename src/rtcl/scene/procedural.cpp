@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rtcl/error.hpp"
+#include "rtcl/scene/orthonormal_basis.hpp"
 
 namespace rtcl {
 
@@ -19,22 +20,12 @@ void check_levels(const char* what, int levels, int most) {
                 std::to_string(most) + "]");
 }
 
-// Two unit vectors completing unit u to an orthonormal basis (Duff et al.,
-// "Building an Orthonormal Basis, Revisited", JCGT 2017).
-void basis(const glm::dvec3& u, glm::dvec3& t1, glm::dvec3& t2) {
-  double sign = std::copysign(1.0, u.z);
-  double a = -1.0 / (sign + u.z);
-  double b = u.x * u.y * a;
-  t1 = glm::dvec3(1.0 + sign * u.x * u.x * a, sign * b, -sign * u.x);
-  t2 = glm::dvec3(b, sign + u.y * u.y * a, -u.y);
-}
-
 void add_flake(Geometry& g, const glm::dvec3& centre, double radius, const glm::dvec3& up, int levels) {
   g.spheres.push_back({glm::vec3(centre), static_cast<float>(radius)});
   if (levels == 0) return;
   constexpr double pi = 3.14159265358979323846;
   glm::dvec3 t1, t2;
-  basis(up, t1, t2);
+  orthonormal_basis(up, t1, t2);
   const double child = radius / 3.0, distance = radius + child;
   for (int k = 0; k < 9; ++k) {
     // six on the equator, three at 60 degrees of latitude between them

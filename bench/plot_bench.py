@@ -1,0 +1,110 @@
+#!/usr/bin/env python3
+"""Plots `rtcl bench` results (bench.json, schema rtcl-bench/1; README,
+"rtcl bench"):
+
+  PREFIX-mrays.png  Mrays/s (kernel time, median with min-max bars) per
+                    structure per scene, one panel per ray set and device;
+  PREFIX-build.png  host build time against primitive count, one line per
+                    structure (run e.g. --scene soup:count=1000,...,
+                    soup:count=4000000 to see how each build grows).
+
+    /usr/bin/python3 bench/plot_bench.py bench-results/bench.json [more.json ...] -o docs/bench
+
+Several JSON files (several machines) merge: their cells are plotted side by
+side, each device named with its machine's CPU. Needs matplotlib (Debian:
+python3-matplotlib).
+"""
+import argparse
+import json
+from collections import defaultdict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def load(paths):
+    """Cells of every file, each with 'device_label' and 'triangles' added."""
+    cells = []
+    for path in paths:
+        with open(path) as f:
+            data = json.load(f)
+        if data.get("schema") != "rtcl-bench/1":
+            raise SystemExit(f"{path}: not an rtcl bench file (schema {data.get('schema')!r})")
+        cpu = data["host"]["cpu"]
+        devices = data["devices"]
+        prims = {s["name"]: s["triangles"] + s["spheres"] for s in data["scenes"]}
+        for cell in data["cells"]:
+            d = devices[cell["device"]]
+            cell = dict(cell)
+            cell["device_label"] = d["name"] if d["type"] != "cpu" else f"{d['platform']} on {cpu}"
+            cell["scene_primitives"] = prims.get(cell["scene"], 0)
+            cells.append(cell)
+    return cells
+
+
+def plot_rates(cells, path):
+    order = {"primary": 0, "shadow": 1, "diffuse": 2}
+    panels = sorted({(c["device_label"], c["rays"]) for c in cells}, key=lambda p: (p[0], order.get(p[1], 3), p[1]))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(10, 3.2 * len(panels)), squeeze=False)
+    for ax, (device, rays) in zip(axes[:, 0], panels):
+        mine = [c for c in cells if c["device_label"] == device and c["rays"] == rays]
+        scenes = list(dict.fromkeys(c["scene"] for c in mine))
+        accels = list(dict.fromkeys(c["accel"] for c in mine))
+        width = 0.8 / max(1, len(accels))
+        for a, accel in enumerate(accels):
+            xs, ys, lo, hi = [], [], [], []
+            for s, scene in enumerate(scenes):
+                for c in mine:
+                    if c["scene"] == scene and c["accel"] == accel:
+                        r = c["mrays_per_s"]["kernel"]
+                        xs.append(s + (a - (len(accels) - 1) / 2) * width)
+                        ys.append(r["median"])
+                        lo.append(r["median"] - r["min"])
+                        hi.append(r["max"] - r["median"])
+            ax.bar(xs, ys, width, yerr=[lo, hi], capsize=2, label=accel)
+        ax.set_xticks(range(len(scenes)))
+        ax.set_xticklabels(scenes, fontsize=8)
+        ax.set_ylabel("Mrays/s (kernel)")
+        ax.set_title(f"{rays} rays, {device}", fontsize=9)
+        ax.legend(fontsize=7, ncol=4)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"written: {path}")
+
+
+def plot_build(cells, path):
+    # One point per (device, structure, scene): the build does not depend on the ray set.
+    points = defaultdict(dict)
+    for c in cells:
+        points[(c["device_label"], c["accel"])][c["scene"]] = (c["scene_primitives"], c["build_ms"])
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for (device, accel), by_scene in sorted(points.items()):
+        xy = sorted(by_scene.values())
+        ax.plot([p[0] for p in xy], [p[1] for p in xy], marker="o", label=f"{accel} ({device})")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("primitives")
+    ax.set_ylabel("host build time (ms)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"written: {path}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("json", nargs="+", help="bench.json files written by `rtcl bench`")
+    parser.add_argument("-o", "--output", default="bench", help="prefix of the PNG files (default: bench)")
+    args = parser.parse_args()
+    cells = load(args.json)
+    if not cells:
+        raise SystemExit("no cells in " + ", ".join(args.json))
+    plot_rates(cells, args.output + "-mrays.png")
+    plot_build(cells, args.output + "-build.png")
+
+
+if __name__ == "__main__":
+    main()

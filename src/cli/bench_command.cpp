@@ -1,0 +1,329 @@
+// `rtcl bench`: structure x scene x ray set x OpenCL device, each cell
+// timed as the benchmarks time it (a warm-up launch, then --repeat kernel
+// launches timed by OpenCL events, and the same launches' wall time with
+// the ray upload and the hit read-back), its hits checked against brute
+// force on a subset of rays; written as bench.json and bench.md (formats:
+// bench_report.hpp, README "rtcl bench"). Every input is checked before the
+// first OpenCL call.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <span>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench_report.hpp"
+#include "bench_scenes.hpp"
+#include "cli_errors.hpp"
+#include "rtcl/cl/opencl.hpp"
+#include "commands.hpp"
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/bench/ray_sets.hpp"
+#include "rtcl/cl/device.hpp"
+#include "rtcl/error.hpp"
+#include "rtcl/io/atomic_file.hpp"
+#include "rtcl_version.hpp"
+
+namespace rtcl::cli {
+
+namespace {
+
+struct BenchOptions {
+  std::string accel, scene = "bunny", rays = "primary,shadow,diffuse", device, scenes_dir, output = "bench-results";
+  int size = 512;
+  int repeat = 5;
+  int check_rays = 256;
+};
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+std::string default_scenes_dir() {
+  if (const char* dir = std::getenv("RTCL_SCENES_DIR"); dir && *dir) return dir;
+  return "/work/shared/scenes";
+}
+
+// Every registered structure but brute force (O(rays x primitives); it
+// answers the check), when --accel is not given.
+std::vector<std::string> default_accels() {
+  std::vector<std::string> out;
+  for (const std::string& name : accel_names())
+    if (name != "brute") out.push_back(name);
+  return out;
+}
+
+std::string host_cpu() {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(cpuinfo, line))
+    if (line.rfind("model name", 0) == 0) {
+      std::size_t colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
+    }
+  return "unknown";
+}
+
+std::string utc_now() {
+  std::time_t now = std::time(nullptr);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
+  return text;
+}
+
+// One line on stderr, rewritten in place on a terminal.
+void progress(std::size_t done, std::size_t total, const std::string& what) {
+  bool tty = isatty(2);
+  std::fprintf(stderr, "%srtcl bench: [%zu/%zu] %s%s", tty ? "\r\033[K" : "", done, total, what.c_str(),
+               tty ? "" : "\n");
+  std::fflush(stderr);
+}
+
+// A scene's three ray sets, generated once (on the first device) and traced
+// unchanged by every structure on every device, with brute force's answers
+// for every k-th ray.
+struct SceneRays {
+  std::vector<Ray> sets[3];  // primary, shadow, diffuse
+  std::vector<std::size_t> checked[3];  // indices of the checked rays
+  std::vector<Hit> reference[3];        // brute force's hits for them
+};
+constexpr const char* kind_names[3] = {"primary", "shadow", "diffuse"};
+Query kind_query(int kind) { return kind == 1 ? Query::any : Query::closest; }
+
+std::vector<Hit> trace_once(const Accel& accel, Query query, std::span<const Ray> rays) {
+  std::vector<Hit> hits(rays.size());
+  if (rays.empty()) return hits;
+  const Device& device = accel.device();
+  cl::Buffer ray_buffer = device.upload(rays.data(), rays.size_bytes(), "benchmark rays");
+  cl::Buffer hit_buffer = device.allocate(hits.size() * sizeof(Hit), "benchmark hits", CL_MEM_WRITE_ONLY);
+  with_cl_errors([&] {
+    std::vector<cl::Event> wait{accel.trace(query, ray_buffer, hit_buffer, rays.size())};
+    device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data(), &wait);
+  });
+  return hits;
+}
+
+SceneRays make_rays(const Device& device, const LoadedBenchScene& scene, int size, std::size_t check_rays) {
+  SceneRays out;
+  out.sets[0] = bench::primary_rays(scene.camera, size, size);
+  // The primary hits that spawn the secondary rays: the BVH's (the check
+  // below tests them against brute force like every other cell).
+  std::vector<std::string> names = accel_names();
+  bool bvh = std::find(names.begin(), names.end(), "bvh") != names.end();
+  std::unique_ptr<Accel> spawner = make_accel(device, bvh ? "bvh" : "brute", scene.geometry);
+  std::vector<Hit> primary_hits = trace_once(*spawner, Query::closest, out.sets[0]);
+  bench::SecondaryRays secondary = bench::secondary_rays(scene.geometry, out.sets[0], primary_hits, scene.light);
+  out.sets[1] = std::move(secondary.shadow);
+  out.sets[2] = std::move(secondary.diffuse);
+  std::unique_ptr<Accel> brute = make_accel(device, "brute", scene.geometry);
+  for (int k = 0; k < 3; ++k) {
+    std::size_t n = out.sets[k].size();
+    std::size_t stride = check_rays == 0 ? n + 1 : std::max<std::size_t>(1, (n + check_rays - 1) / check_rays);
+    std::vector<Ray> subset;
+    for (std::size_t i = 0; i < n; i += stride) {
+      out.checked[k].push_back(i);
+      subset.push_back(out.sets[k][i]);
+    }
+    out.reference[k] = trace_once(*brute, kind_query(k), subset);
+  }
+  return out;
+}
+
+// Agreement with brute force: same hit / miss and, for closest hits, the
+// same primitive or a t within a relative 1e-3 (another triangle at the
+// same distance, e.g. across a shared edge).
+std::size_t disagreeing(const std::vector<Hit>& hits, const SceneRays& rays, int kind) {
+  std::size_t bad = 0;
+  for (std::size_t j = 0; j < rays.checked[kind].size(); ++j) {
+    const Hit &a = hits[rays.checked[kind][j]], &b = rays.reference[kind][j];
+    bool hit_a = a.prim >= 0, hit_b = b.prim >= 0;
+    if (hit_a != hit_b) ++bad;
+    else if (hit_a && kind_query(kind) == Query::closest && a.prim != b.prim && std::abs(a.t - b.t) > 1e-3f * std::abs(b.t))
+      ++bad;
+  }
+  return bad;
+}
+
+// One cell: a warm-up launch, then `repeat` launches, each uploading the
+// rays, tracing and reading the hits back (wall) with the kernel's own time
+// from its profiling event.
+void measure(const Accel& accel, const SceneRays& rays, int kind, int repeat, BenchCell& cell) {
+  const std::vector<Ray>& set = rays.sets[kind];
+  cell.ray_count = set.size();
+  if (set.empty()) return;
+  const Device& device = accel.device();
+  Query query = kind_query(kind);
+  std::vector<Hit> hits(set.size());
+  cl::Buffer ray_buffer = device.upload(set.data(), set.size() * sizeof(Ray), "benchmark rays");
+  cl::Buffer hit_buffer = device.allocate(hits.size() * sizeof(Hit), "benchmark hits", CL_MEM_WRITE_ONLY);
+  cell.profiled = device.profiling();
+  with_cl_errors([&] {
+    Clock::time_point start = Clock::now();
+    accel.trace(query, ray_buffer, hit_buffer, set.size()).wait();
+    cell.first_launch_ms = ms_since(start);
+    for (int r = 0; r < repeat; ++r) {
+      start = Clock::now();
+      cl::Event written;
+      device.queue().enqueueWriteBuffer(ray_buffer, CL_FALSE, 0, set.size() * sizeof(Ray), set.data(), nullptr,
+                                        &written);
+      cl::Event done = accel.trace(query, ray_buffer, hit_buffer, set.size(), {written});
+      std::vector<cl::Event> wait{done};
+      device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data(), &wait);
+      cell.wall_ms.push_back(ms_since(start));
+      double kernel = cell.wall_ms.back();
+      if (cell.profiled)
+        kernel = static_cast<double>(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                                     done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6;
+      cell.kernel_ms.push_back(kernel);
+    }
+  });
+  cell.checked = rays.checked[kind].size();
+  cell.disagreeing = disagreeing(hits, rays, kind);
+}
+
+void run_bench(const BenchOptions& options) {
+  // --- every input, before any OpenCL call ---
+  BenchRun run;
+  std::vector<std::string> accels = options.accel.empty() ? default_accels() : split_spec_list(options.accel);
+  for (const std::string& a : accels) {
+    if (a.empty()) throw UsageError("--accel " + options.accel + ": empty structure name in the list");
+    parse_accel_spec(a);  // unknown structure or option: "--accel TEXT: ..."
+  }
+  std::string scenes_dir = options.scenes_dir.empty() ? default_scenes_dir() : options.scenes_dir;
+  std::vector<BenchSceneSpec> scenes;
+  for (const std::string& s : split_spec_list(options.scene)) scenes.push_back(parse_bench_scene(s, scenes_dir));
+  std::vector<int> kinds;
+  for (const std::string& r : split_spec_list(options.rays)) {
+    auto k = std::find(std::begin(kind_names), std::end(kind_names), r);
+    if (k == std::end(kind_names))
+      throw UsageError("--rays " + options.rays + ": unknown ray set '" + r + "' (known: primary, shadow, diffuse)");
+    kinds.push_back(static_cast<int>(k - std::begin(kind_names)));
+  }
+  std::error_code error;
+  std::filesystem::create_directories(options.output, error);
+  if (error) throw Error("-o " + options.output + ": cannot create the directory: " + error.message());
+  std::string json_path = options.output + "/bench.json", md_path = options.output + "/bench.md";
+  check_writable(json_path);
+  check_writable(md_path);
+  // A cache of its own, so that no other program's kernels are timed or
+  // evicted; compile time shows in setup_ms / first_launch_ms only.
+  if (const char* cache = std::getenv("POCL_CACHE_DIR"); !cache || !*cache) {
+    std::string dir = std::filesystem::absolute(options.output + "/pocl-cache").string();
+    setenv("POCL_CACHE_DIR", dir.c_str(), 1);
+  }
+  run.pocl_cache_dir = std::getenv("POCL_CACHE_DIR");
+
+  // --- devices ---
+  std::vector<DeviceInfo> infos = list_devices();
+  if (infos.empty()) throw Error("no OpenCL device found (`rtcl devices` lists them)");
+  std::vector<Device> devices;
+  if (!options.device.empty()) {
+    devices.push_back(Device::open(options.device));
+  } else {
+    for (const DeviceInfo& info : infos) devices.push_back(Device::open(std::to_string(info.index)));
+  }
+  for (const Device& device : devices) {
+    const DeviceInfo& info = device.info();
+    std::string driver = with_cl_errors([&] { return device.device().getInfo<CL_DRIVER_VERSION>(); });
+    run.devices.push_back({info.index, info.name, info.platform, info.type, info.version, driver});
+  }
+
+  run.rtcl_version = RTCL_VERSION;
+  run.rtcl_commit = RTCL_GIT_DESCRIBE;
+  run.host_cpu = host_cpu();
+  run.host_threads = std::max(1u, std::thread::hardware_concurrency());
+  run.started_utc = utc_now();
+  run.size = options.size;
+  run.repeat = options.repeat;
+  run.check_rays = static_cast<std::size_t>(options.check_rays);
+  run.accels = accels;
+  for (const BenchSceneSpec& s : scenes) run.scenes.push_back(s.text);
+  for (int k : kinds) run.ray_kinds.push_back(kind_names[k]);
+
+  std::size_t total = scenes.size() * devices.size() * accels.size() * kinds.size(), done = 0;
+  for (const BenchSceneSpec& scene_spec : scenes) {
+    progress(done, total, scene_spec.text + ": loading, rays and brute-force references");
+    LoadedBenchScene scene = load_bench_scene(scene_spec);
+    Clock::time_point rays_start = Clock::now();
+    SceneRays rays = make_rays(devices.front(), scene, options.size, run.check_rays);
+    run.scene_info.push_back({scene_spec.text, scene.geometry.triangles.size(), scene.geometry.spheres.size(),
+                              scene.load_ms, ms_since(rays_start), rays.sets[0].size(), rays.sets[1].size(),
+                              rays.sets[2].size()});
+    for (std::size_t d = 0; d < devices.size(); ++d)
+      for (const std::string& accel_name : accels) {
+        progress(done, total, scene_spec.text + " / " + accel_name + " / " + run.devices[d].name + ": build");
+        Clock::time_point start = Clock::now();
+        std::unique_ptr<Accel> accel = make_accel(devices[d], accel_name, scene.geometry);
+        double setup = ms_since(start);
+        const AccelStats& stats = accel->stats();
+        for (int k : kinds) {
+          progress(done, total, scene_spec.text + " / " + accel_name + " / " + kind_names[k] + " / " +
+                                    run.devices[d].name);
+          BenchCell cell;
+          cell.device = d;
+          cell.scene = scene_spec.text;
+          cell.accel = accel_name;
+          cell.rays = kind_names[k];
+          cell.query = kind_query(k) == Query::any ? "any" : "closest";
+          cell.build_ms = stats.build_ms;
+          cell.setup_ms = std::max(0.0, setup - stats.build_ms);
+          cell.device_bytes = stats.device_bytes;
+          cell.primitives = stats.primitive_count;
+          measure(*accel, rays, k, options.repeat, cell);
+          run.cells.push_back(std::move(cell));
+          ++done;
+        }
+      }
+  }
+  progress(done, total, "done");
+  if (isatty(2)) std::fputc('\n', stderr);
+
+  std::string json = bench_json(run), md = bench_markdown(run);
+  write_file_atomically(json_path, std::as_bytes(std::span(json.data(), json.size())));
+  write_file_atomically(md_path, std::as_bytes(std::span(md.data(), md.size())));
+  std::fputs(md.c_str(), stdout);
+  std::printf("\nwritten: %s, %s\n", json_path.c_str(), md_path.c_str());
+}
+
+}  // namespace
+
+void add_bench_command(CLI::App& app) {
+  auto options = std::make_shared<BenchOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "bench", "Benchmark structures x scenes x ray sets x OpenCL devices; write bench.json and bench.md");
+  cmd->add_option("--accel", options->accel,
+                  "structures, comma-separated, each with build options as NAME:key=value,... (default: every "
+                  "registered structure but brute)");
+  cmd->add_option("--scene", options->scene, "scenes, comma-separated: " + bench_scene_names())
+      ->capture_default_str();
+  cmd->add_option("--rays", options->rays, "ray sets, comma-separated: primary, shadow, diffuse")
+      ->capture_default_str();
+  cmd->add_option("--device", options->device,
+                  "one OpenCL device: index or name substring from `rtcl devices` (default: every device)");
+  cmd->add_option("--size", options->size, "image side in pixels: size x size primary rays")
+      ->check(CLI::Range(1, 16384))
+      ->capture_default_str();
+  cmd->add_option("--repeat", options->repeat, "timed launches per cell, after one warm-up launch")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  cmd->add_option("--check-rays", options->check_rays,
+                  "rays per set (every k-th) compared with brute force; 0: none")
+      ->check(CLI::Range(0, 1 << 20))
+      ->capture_default_str();
+  cmd->add_option("--scenes-dir", options->scenes_dir,
+                  "directory of the shared meshes (default: $RTCL_SCENES_DIR, else /work/shared/scenes)");
+  cmd->add_option("-o,--output", options->output, "directory for bench.json and bench.md (created if missing)")
+      ->capture_default_str();
+  cmd->callback([options] { run_bench(*options); });
+}
+
+}  // namespace rtcl::cli

@@ -1,0 +1,150 @@
+#include "bench_report.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+#include <nlohmann/json.hpp>
+
+namespace rtcl::cli {
+
+Spread spread_of(std::vector<double> values) {
+  if (values.empty()) return {};
+  std::sort(values.begin(), values.end());
+  std::size_t n = values.size();
+  double median = n % 2 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+  return {values.front(), median, values.back()};
+}
+
+namespace {
+
+using nlohmann::json;
+
+json spread_json(const Spread& s) { return {{"min", s.min}, {"median", s.median}, {"max", s.max}}; }
+
+// Mrays/s for each of min / median / max time: the fastest rate from the
+// shortest time. A time of 0 (a timer too coarse for a tiny launch) gives 0.
+Spread rate_of(std::size_t rays, const Spread& ms) {
+  auto rate = [rays](double t) { return t > 0.0 ? static_cast<double>(rays) / (t * 1e3) : 0.0; };
+  return {rate(ms.max), rate(ms.median), rate(ms.min)};
+}
+
+json cell_json(const BenchCell& c) {
+  Spread kernel = spread_of(c.kernel_ms), wall = spread_of(c.wall_ms);
+  return {
+      {"device", c.device},
+      {"scene", c.scene},
+      {"accel", c.accel},
+      {"rays", c.rays},
+      {"query", c.query},
+      {"ray_count", c.ray_count},
+      {"build_ms", c.build_ms},
+      {"setup_ms", c.setup_ms},
+      {"first_launch_ms", c.first_launch_ms},
+      {"device_bytes", c.device_bytes},
+      {"primitives", c.primitives},
+      {"bytes_per_primitive",
+       c.primitives ? static_cast<double>(c.device_bytes) / static_cast<double>(c.primitives) : 0.0},
+      {"kernel_ms", spread_json(kernel)},
+      {"kernel_timer", c.profiled ? "opencl-events" : "host-clock"},
+      {"wall_ms", spread_json(wall)},
+      {"mrays_per_s", {{"kernel", spread_json(rate_of(c.ray_count, kernel))},
+                       {"wall", spread_json(rate_of(c.ray_count, wall))}}},
+      {"kernel_ms_runs", c.kernel_ms},
+      {"wall_ms_runs", c.wall_ms},
+      {"check", {{"reference", "brute"}, {"rays", c.checked}, {"disagreeing", c.disagreeing},
+                 {"ok", c.disagreeing == 0}}},
+      // Filled by a run with an Embree baseline: {"mrays_per_s": {...},
+      // "api": "rtcIntersect1" | ..., "threads": N, "ratio": rtcl / Embree}.
+      {"embree", nullptr},
+  };
+}
+
+}  // namespace
+
+std::string bench_json(const BenchRun& run) {
+  json devices = json::array(), scenes = json::array(), cells = json::array();
+  for (const BenchDevice& d : run.devices)
+    devices.push_back({{"index", d.index}, {"name", d.name}, {"platform", d.platform}, {"type", d.type},
+                       {"version", d.version}, {"driver", d.driver}});
+  for (const BenchSceneInfo& s : run.scene_info)
+    scenes.push_back({{"name", s.name}, {"triangles", s.triangles}, {"spheres", s.spheres}, {"load_ms", s.load_ms},
+                      {"rays_ms", s.rays_ms},
+                      {"rays", {{"primary", s.primary}, {"shadow", s.shadow}, {"diffuse", s.diffuse}}}});
+  for (const BenchCell& c : run.cells) cells.push_back(cell_json(c));
+  json out = {
+      {"schema", "rtcl-bench/1"},
+      {"rtcl", {{"version", run.rtcl_version}, {"commit", run.rtcl_commit}}},
+      {"host", {{"cpu", run.host_cpu}, {"threads", run.host_threads}}},
+      {"started_utc", run.started_utc},
+      {"options", {{"size", run.size}, {"repeat", run.repeat}, {"check_rays", run.check_rays},
+                   {"accel", run.accels}, {"scene", run.scenes}, {"rays", run.ray_kinds},
+                   {"pocl_cache_dir", run.pocl_cache_dir}}},
+      {"devices", devices},
+      {"scenes", scenes},
+      {"cells", cells},
+  };
+  return out.dump(2) + "\n";
+}
+
+namespace {
+
+std::string format(const char* pattern, double a, double b = 0.0, double c = 0.0) {
+  char text[96];
+  std::snprintf(text, sizeof text, pattern, a, b, c);
+  return text;
+}
+
+const BenchCell* find_cell(const BenchRun& run, std::size_t device, const std::string& scene, const std::string& accel,
+                           const std::string& rays) {
+  for (const BenchCell& c : run.cells)
+    if (c.device == device && c.scene == scene && c.accel == accel && c.rays == rays) return &c;
+  return nullptr;
+}
+
+}  // namespace
+
+std::string bench_markdown(const BenchRun& run) {
+  std::string md = "rtcl " + run.rtcl_commit + ", " + run.host_cpu + " (" + std::to_string(run.host_threads) +
+                   " threads), " + std::to_string(run.size) + "x" + std::to_string(run.size) +
+                   " rays per primary set, median (min - max) Mrays/s of " + std::to_string(run.repeat) +
+                   " kernel launches after a warm-up (OpenCL event times); build: host ms; B/prim: device bytes per "
+                   "primitive; check: rays agreeing with brute force.\n";
+  for (std::size_t d = 0; d < run.devices.size(); ++d) {
+    const BenchDevice& device = run.devices[d];
+    md += "\n### [" + std::to_string(device.index) + "] " + device.name + " (" + device.platform + ", driver " +
+          device.driver + ")\n\n| scene | structure | build ms | B/prim |";
+    for (const std::string& rays : run.ray_kinds) md += " " + rays + " |";
+    md += " check |\n|---|---|---:|---:|";
+    for (std::size_t i = 0; i < run.ray_kinds.size(); ++i) md += "---:|";
+    md += "---|\n";
+    for (const std::string& scene : run.scenes)
+      for (const std::string& accel : run.accels) {
+        const BenchCell* first = nullptr;
+        std::string row, check;
+        std::size_t checked = 0, disagreeing = 0;
+        for (const std::string& rays : run.ray_kinds) {
+          const BenchCell* c = find_cell(run, d, scene, accel, rays);
+          if (!c) {
+            row += " - |";
+            continue;
+          }
+          if (!first) first = c;
+          Spread rate = rate_of(c->ray_count, spread_of(c->kernel_ms));
+          row += format(" %.2f (%.2f - %.2f) |", rate.median, rate.min, rate.max);
+          checked += c->checked;
+          disagreeing += c->disagreeing;
+        }
+        if (!first) continue;
+        check = disagreeing == 0 ? "ok " + std::to_string(checked)
+                                 : "**DISAGREES " + std::to_string(disagreeing) + "/" + std::to_string(checked) + "**";
+        double per_prim = first->primitives ? static_cast<double>(first->device_bytes) /
+                                                  static_cast<double>(first->primitives)
+                                            : 0.0;
+        md += "| " + scene + " | " + accel + " |" + format(" %.1f |", first->build_ms) +
+              format(" %.1f |", per_prim) + row + " " + check + " |\n";
+      }
+  }
+  return md;
+}
+
+}  // namespace rtcl::cli

@@ -1,0 +1,67 @@
+// What `rtcl bench` measured, and its two renderings: bench.json (every
+// figure, the machine and the options, so that runs from several machines
+// merge) and bench.md (one table per device). Schema: README, "rtcl bench".
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace rtcl::cli {
+
+// min / median / max of repeated measurements, in the unit the field names.
+struct Spread {
+  double min = 0.0, median = 0.0, max = 0.0;
+};
+Spread spread_of(std::vector<double> values);  // all 0 for no values
+
+struct BenchCell {
+  std::size_t device = 0;  // index into BenchRun::devices
+  std::string scene, accel, rays, query;  // rays: primary | shadow | diffuse; query: closest | any
+  std::size_t ray_count = 0;
+  double build_ms = 0.0;       // host build (AccelStats::build_ms)
+  // make_accel's wall time less build_ms: the upload and the closest-hit
+  // program's build. Programs are cached per process and device, so a
+  // structure's first cell carries the build (the BVH's: rays_ms of the
+  // first scene), and PoCL's own cache (POCL_CACHE_DIR) shortens it on
+  // later runs.
+  double setup_ms = 0.0;
+  double first_launch_ms = 0.0;  // the warm-up launch, wall: includes the query's program build at its first use
+  std::size_t device_bytes = 0;
+  std::size_t primitives = 0;
+  std::vector<double> kernel_ms, wall_ms;  // per timed launch, in launch order
+  bool profiled = false;                   // kernel_ms from OpenCL events (else the host clock)
+  std::size_t checked = 0, disagreeing = 0;  // rays compared with brute force, and those that differ
+};
+
+struct BenchDevice {
+  std::size_t index = 0;  // list_devices() index
+  std::string name, platform, type, version, driver;
+};
+
+struct BenchSceneInfo {
+  std::string name;
+  std::size_t triangles = 0, spheres = 0;
+  double load_ms = 0.0;
+  // Ray generation on the first device: the BVH that spawns the secondary
+  // rays (its build and closest-hit program build included) and brute
+  // force's reference hits.
+  double rays_ms = 0.0;
+  std::size_t primary = 0, shadow = 0, diffuse = 0;  // rays in each set
+};
+
+struct BenchRun {
+  std::string rtcl_version, rtcl_commit, host_cpu, started_utc, pocl_cache_dir;
+  unsigned host_threads = 0;
+  int size = 0, repeat = 0;
+  std::size_t check_rays = 0;
+  std::vector<std::string> accels, scenes, ray_kinds;
+  std::vector<BenchDevice> devices;
+  std::vector<BenchSceneInfo> scene_info;
+  std::vector<BenchCell> cells;
+};
+
+std::string bench_json(const BenchRun& run);
+std::string bench_markdown(const BenchRun& run);
+
+}  // namespace rtcl::cli

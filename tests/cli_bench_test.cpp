@@ -1,0 +1,93 @@
+// `rtcl bench` on tiny sizes: the JSON holds a complete cell for every
+// requested structure, scene and ray set (figures are never asserted), and
+// bad input fails with one message before any device work.
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "support/cli_run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace rtcl::test {
+namespace {
+
+std::string scenes_env() { return std::string("RTCL_SCENES_DIR=") + shell_quoted(RTCL_SCENE_DIR); }
+
+TEST(CliBench, SmokeRunWritesACompleteMatrix) {
+  TempDir dir;
+  CliRun run = run_cli(dir,
+                       {"bench", "--size", "32", "--scene", "bunny,tetra:levels=2", "--accel", "bvh,grid",
+                        "--repeat", "2", "--check-rays", "64", "--device", "0", "-o", dir.file("out")},
+                       scenes_env());
+  ASSERT_EQ(run.status, 0) << run.err;
+  nlohmann::json json = nlohmann::json::parse(read_text(dir.file("out/bench.json")));
+  EXPECT_EQ(json["schema"], "rtcl-bench/1");
+  EXPECT_TRUE(json["rtcl"]["commit"].is_string());
+  EXPECT_TRUE(json["host"]["cpu"].is_string());
+  ASSERT_EQ(json["devices"].size(), 1u);
+  EXPECT_TRUE(json["devices"][0]["driver"].is_string());
+  EXPECT_EQ(json["options"]["repeat"], 2);
+  std::set<std::tuple<std::string, std::string, std::string>> seen;
+  for (const auto& cell : json["cells"]) {
+    seen.insert({cell["scene"].get<std::string>(), cell["accel"].get<std::string>(), cell["rays"].get<std::string>()});
+    for (const char* field : {"build_ms", "setup_ms", "first_launch_ms", "device_bytes", "bytes_per_primitive"})
+      EXPECT_TRUE(cell[field].is_number()) << field << " in " << cell.dump();
+    for (const char* timer : {"kernel", "wall"})
+      for (const char* stat : {"min", "median", "max"})
+        EXPECT_TRUE(cell["mrays_per_s"][timer][stat].is_number()) << timer << " " << stat;
+    EXPECT_EQ(cell["kernel_ms_runs"].size(), 2u);
+    EXPECT_EQ(cell["wall_ms_runs"].size(), 2u);
+    EXPECT_TRUE(cell["check"]["ok"].is_boolean());
+    EXPECT_GT(cell["check"]["rays"].get<int>(), 0) << cell.dump();
+    EXPECT_TRUE(cell.contains("embree"));
+    EXPECT_EQ(cell["query"], cell["rays"] == "shadow" ? "any" : "closest");
+  }
+  for (const char* scene : {"bunny", "tetra:levels=2"})
+    for (const char* accel : {"bvh", "grid"})
+      for (const char* rays : {"primary", "shadow", "diffuse"})
+        EXPECT_TRUE(seen.count({scene, accel, rays})) << scene << " " << accel << " " << rays;
+  EXPECT_EQ(seen.size(), json["cells"].size());
+  std::string md = read_text(dir.file("out/bench.md"));
+  EXPECT_NE(md.find("| tetra:levels=2 | grid |"), std::string::npos) << md;
+}
+
+// Each bad input: a non-zero exit and one "rtcl: error:" line naming it,
+// nothing written.
+TEST(CliBench, BadInputIsOneMessageBeforeDeviceWork) {
+  TempDir dir;
+  dir.write("blocker", "a file, not a directory");
+  struct Case {
+    std::vector<std::string> args;
+    std::string fragment;
+  };
+  std::vector<Case> cases = {
+      {{"--accel", "bvh,octree-x"}, "octree-x"},
+      {{"--scene", "bunny,cube"}, "unknown scene 'cube'"},
+      {{"--scene", "tetra:levels=99"}, "levels must be an integer in [0, 11]"},
+      {{"--scene", "soup:size=5"}, "count=N"},
+      {{"--rays", "primary,caustic"}, "unknown ray set 'caustic'"},
+      {{"--repeat", "0"}, "--repeat"},
+      {{"-o", dir.file("blocker") + "/out"}, "cannot create the directory"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"bench", "--size", "8"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    if (c.args[0] != "-o") args.insert(args.end(), {"-o", dir.file("out")});
+    CliRun run = run_cli(dir, args, scenes_env());
+    EXPECT_NE(run.status, 0) << c.fragment;
+    EXPECT_EQ(count_of(run.err, "rtcl: error:"), 1u) << run.err;
+    EXPECT_NE(run.err.find(c.fragment), std::string::npos) << run.err;
+    EXPECT_EQ(run.err.find("rtcl bench: ["), std::string::npos) << "device work started: " << run.err;
+  }
+  CliRun missing = run_cli(dir, {"bench", "--scene", "dragon", "--scenes-dir", dir.path(), "-o", dir.file("out")});
+  EXPECT_NE(missing.status, 0);
+  EXPECT_NE(missing.err.find("stanford_dragon_100k/dragon.obj not found"), std::string::npos) << missing.err;
+}
+
+}  // namespace
+}  // namespace rtcl::test
