@@ -103,11 +103,16 @@ int main(int argc, char** argv) {
     rows.push_back(measure(c.name, c.points, nullptr, 0));
 
   const std::vector<BoundEntry>& first = rows.front().report.entries;
+  // The rest of a table's header: one column per volume, after `lead` columns.
+  auto volume_columns = [&](int lead) {
+    for (const BoundEntry& e : first) std::printf(" %s |", e.name.c_str());
+    std::printf("\n|");
+    for (int i = 0; i < lead; ++i) std::printf("---|");
+    for (std::size_t i = 0; i < first.size(); ++i) std::printf("---|");
+    std::printf("\n");
+  };
   std::printf("### Volume relative to the AABB\n\n| points |");
-  for (const BoundEntry& e : first) std::printf(" %s |", e.name.c_str());
-  std::printf("\n|---|");
-  for (std::size_t i = 0; i < first.size(); ++i) std::printf("---|");
-  std::printf("\n");
+  volume_columns(1);
   for (const Row& r : rows) {
     std::printf("| %s (%zu) |", r.name.c_str(), r.report.point_count);
     for (const BoundEntry& e : r.report.entries)
@@ -115,10 +120,7 @@ int main(int argc, char** argv) {
     std::printf("\n");
   }
   std::printf("\n### Surface area relative to the AABB\n\n| points |");
-  for (const BoundEntry& e : first) std::printf(" %s |", e.name.c_str());
-  std::printf("\n|---|");
-  for (std::size_t i = 0; i < first.size(); ++i) std::printf("---|");
-  std::printf("\n");
+  volume_columns(1);
   for (const Row& r : rows) {
     std::printf("| %s |", r.name.c_str());
     for (const BoundEntry& e : r.report.entries) std::printf(" %.3f |", e.area / r.report.aabb().area);
@@ -151,20 +153,14 @@ int main(int argc, char** argv) {
                 ratio.back(), *std::max_element(iterated.begin(), iterated.end()));
   }
   std::printf("\n### Build time, ms (host, one thread)\n\n| points |");
-  for (const BoundEntry& e : first) std::printf(" %s |", e.name.c_str());
-  std::printf("\n|---|");
-  for (std::size_t i = 0; i < first.size(); ++i) std::printf("---|");
-  std::printf("\n");
+  volume_columns(1);
   for (const Row& r : rows) {
     std::printf("| %s |", r.name.c_str());
     for (const BoundEntry& e : r.report.entries) std::printf(" %.3f |", e.build_ms);
     std::printf("\n");
   }
   std::printf("\n### Easy-reject rate: rays that hit the AABB but miss the mesh, share rejected\n\n| mesh | rays |");
-  for (const BoundEntry& e : first) std::printf(" %s |", e.name.c_str());
-  std::printf("\n|---|---|");
-  for (std::size_t i = 0; i < first.size(); ++i) std::printf("---|");
-  std::printf("\n");
+  volume_columns(2);
   for (const Row& r : rows) {
     if (r.reject.empty()) continue;
     std::printf("| %s | %zu |", r.name.c_str(), r.candidate_rays);

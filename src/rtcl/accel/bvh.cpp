@@ -277,11 +277,8 @@ Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_le
 
 std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size) { return std::max(8u, (stack_size + 7u) / 8u * 8u); }
 
-std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config,
-                                std::string name, const AccelConfig& accel_config) {
-  auto start = std::chrono::steady_clock::now();
-  GeometryReport report = validate(geometry);
-  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, config), geometry, config.merge_leaves);
+AccelStats bvh_stats(const Geometry& geometry, const GeometryReport& report, const Bvh8& bvh,
+                     std::chrono::steady_clock::time_point start) {
   AccelStats stats;
   stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   stats.device_bytes = bvh.nodes.size() * sizeof(Bvh8Node) + bvh.blocks.bytes();
@@ -289,8 +286,22 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
   stats.zero_area_skipped = report.zero_area_triangles;
   stats.node_count = bvh.nodes.size();
   stats.leaf_count = bvh.blocks.triangles.size() + bvh.blocks.spheres.size();
+  return stats;
+}
+
+std::vector<std::string> bvh_defines(const Geometry& geometry, const Bvh8& bvh) {
   std::vector<std::string> defines = primitive_defines(geometry);
   defines.push_back("RTCL_STACK_SIZE=" + std::to_string(bvh_kernel_stack_size(bvh.stack_size)));
+  return defines;
+}
+
+std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config,
+                                std::string name, const AccelConfig& accel_config) {
+  auto start = std::chrono::steady_clock::now();
+  GeometryReport report = validate(geometry);
+  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, config), geometry, config.merge_leaves);
+  AccelStats stats = bvh_stats(geometry, report, bvh, start);
+  std::vector<std::string> defines = bvh_defines(geometry, bvh);
   return std::make_unique<BvhAccel>(device, std::move(name), config.traversal, std::move(defines), bvh, stats,
                                     accel_config);
 }

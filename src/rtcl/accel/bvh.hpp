@@ -4,6 +4,7 @@
 // blocks of up to eight triangles or eight spheres.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -92,6 +93,12 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
 // the BVH, bvh_mixed.hpp).
 const std::vector<OptionSpec>& bvh_sah_options();
 BvhConfig resolve_bvh_config(const StructureSpec& structure, const AccelConfig& config);
+
+// The stats of a BVH built since `start` over validated `geometry`, and the
+// defines of its traversal kernels (bvh and bvh-mixed).
+AccelStats bvh_stats(const Geometry& geometry, const GeometryReport& report, const Bvh8& bvh,
+                     std::chrono::steady_clock::time_point start);
+std::vector<std::string> bvh_defines(const Geometry& geometry, const Bvh8& bvh);
 
 // Their registry entries; the options set the SahConfig / PlocConfig fields
 // of the same name and BvhConfig::merge_leaves.

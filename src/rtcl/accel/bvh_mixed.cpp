@@ -66,18 +66,11 @@ std::unique_ptr<Accel> make_bvh_mixed(const Device& device, const Geometry& geom
   GeometryReport report = validate(geometry);
   Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, bvh_config), geometry, bvh_config.merge_leaves);
   BvhSphereFilters filters = choose_sphere_filters(bvh, costs, geometry.source);
-  AccelStats stats;
-  stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  stats.device_bytes = bvh.nodes.size() * sizeof(Bvh8Node) + bvh.blocks.bytes() +
-                       (filters.records.empty() ? 0
-                                                : filters.sphere_of.size() * sizeof(rtcl_i32) +
-                                                      filters.records.size() * sizeof(Bvh8Spheres));
-  stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
-  stats.zero_area_skipped = report.zero_area_triangles;
-  stats.node_count = bvh.nodes.size();
-  stats.leaf_count = bvh.blocks.triangles.size() + bvh.blocks.spheres.size();
-  std::vector<std::string> defines = primitive_defines(geometry);
-  defines.push_back("RTCL_STACK_SIZE=" + std::to_string(bvh_kernel_stack_size(bvh.stack_size)));
+  AccelStats stats = bvh_stats(geometry, report, bvh, start);
+  if (!filters.records.empty())
+    stats.device_bytes +=
+        filters.sphere_of.size() * sizeof(rtcl_i32) + filters.records.size() * sizeof(Bvh8Spheres);
+  std::vector<std::string> defines = bvh_defines(geometry, bvh);
   if (!filters.records.empty()) defines.push_back("RTCL_BVH_SPHERES");
   return std::make_unique<MixedBvhAccel>(device, std::move(defines), bvh, filters, stats, config);
 }

@@ -65,7 +65,7 @@ void grow_points(Kdop& k, const std::vector<glm::vec3>& points) {
 
 }  // namespace
 
-SlabVolume Kdop::record() const {
+SlabVolume slab_record(int count, const glm::vec3* normal, const float* d_near, const float* d_far, float reach) {
   SlabVolume v{};
   v.count = count;
   for (int i = 0; i < count; ++i) {
@@ -78,6 +78,8 @@ SlabVolume Kdop::record() const {
   v.reach = reach;
   return v;
 }
+
+SlabVolume Kdop::record() const { return slab_record(count, normal.data(), d_near.data(), d_far.data(), reach); }
 
 const std::vector<int>& kdop_direction_counts() {
   static const std::vector<int> counts = {3, 4, 7, 9, 13};

@@ -115,19 +115,7 @@ double Obb::area() const {
   return 2.0 * (e[0] * e[1] + e[1] * e[2] + e[2] * e[0]);
 }
 
-SlabVolume Obb::record() const {
-  SlabVolume v{};
-  v.count = 3;
-  for (int k = 0; k < 3; ++k) {
-    v.normal[k][0] = axis[k].x;
-    v.normal[k][1] = axis[k].y;
-    v.normal[k][2] = axis[k].z;
-    v.d_near[k] = d_near[k];
-    v.d_far[k] = d_far[k];
-  }
-  v.reach = reach;
-  return v;
-}
+SlabVolume Obb::record() const { return slab_record(3, axis, d_near, d_far, reach); }
 
 Obb obb_of_points(const std::vector<glm::vec3>& points, const std::string& source) {
   check_points(points, source);
