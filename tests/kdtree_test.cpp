@@ -1,7 +1,10 @@
 // The SAH kd-tree (src/rtcl/accel/kdtree.cpp, kernels/accel/kdtree.cl):
 // splits placed by the SAH over sorted events, perfect splits, leaves when
 // no split pays, and traversal answers identical to brute force on soups
-// with spheres, the bunny, a flat scene and rays in and on split planes.
+// with spheres, the bunny, a flat scene and rays in and on split planes,
+// by the single-ray kernel and by the packet kernel
+// (kernels/accel/kdtree_packet.cl: mixed direction signs and +0 / -0 in one
+// packet, partial packets).
 #include <gtest/gtest.h>
 
 #include <algorithm>
