@@ -101,9 +101,10 @@ TEST(BvhPacket, CoherenceSelectsTheKernel) {
   for (const std::string& name : accel_names()) {
     SCOPED_TRACE(name);
     auto accel = make_accel(test_device(), name, g);
-    bool bvh = name.rfind("bvh", 0) == 0 && name != "bvh-mixed";
-    EXPECT_EQ(accel->rays_per_work_item(Coherence::incoherent), name == "bvh-packet" ? 8u : 1u);
-    EXPECT_EQ(accel->rays_per_work_item(Coherence::coherent), bvh ? 8u : 1u);
+    bool packets = (name.rfind("bvh", 0) == 0 && name != "bvh-mixed") || name.rfind("kdtree", 0) == 0;
+    bool always = name == "bvh-packet" || name == "kdtree-packet";
+    EXPECT_EQ(accel->rays_per_work_item(Coherence::incoherent), always ? 8u : 1u);
+    EXPECT_EQ(accel->rays_per_work_item(Coherence::coherent), packets ? 8u : 1u);
   }
 }
 

@@ -40,11 +40,13 @@ TEST(KdNodes, AChainOfTheDeepestDepthFillsTheStackExactly) {
   }
   std::vector<Ray> planes = split_plane_rays(tree, 13, 300);
   rays.insert(rays.end(), planes.begin(), planes.end());
-  for (Precision level : {Precision::robust, Precision::exact}) {
-    AccelStats stats;
-    auto accel = make_kd_accel(test_device(), g, "kdtree", tree, stats, AccelConfig{level, {}});
-    expect_same_as_brute(*accel, g, rays, level);
-  }
+  for (KdTraversal traversal : {KdTraversal::single, KdTraversal::packet})  // one ray, packets of 8
+    for (Precision level : {Precision::robust, Precision::exact}) {
+      AccelStats stats;
+      auto accel = make_kd_accel(test_device(), g, traversal == KdTraversal::packet ? "kdtree-packet" : "kdtree", tree,
+                                 stats, AccelConfig{level, {}}, traversal);
+      expect_same_as_brute(*accel, g, rays, level);
+    }
   // One level more is refused before any upload.
   KdBuildNode deeper;
   deeper.axis = 0;

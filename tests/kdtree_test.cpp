@@ -1,16 +1,25 @@
 // The SAH kd-tree (src/rtcl/accel/kdtree.cpp, kernels/accel/kdtree.cl):
 // splits placed by the SAH over sorted events, perfect splits, leaves when
 // no split pays, and traversal answers identical to brute force on soups
-// with spheres, the bunny, a flat scene and rays in and on split planes.
+// with spheres, the bunny, a flat scene and rays in and on split planes,
+// by the single-ray kernel and by the packet kernel
+// (kernels/accel/kdtree_packet.cl: mixed direction signs and +0 / -0 in one
+// packet, partial packets).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
+#include <cstring>
+#include <limits>
+#include <memory>
 #include <random>
 
+#include "rtcl/accel/brute.hpp"
 #include "rtcl/accel/bsp.hpp"
 #include "rtcl/accel/kdtree.hpp"
 #include "rtcl/bounds/clip.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/render/ray_order.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "support/error_of.hpp"
 #include "support/fixtures.hpp"
@@ -170,6 +179,149 @@ TEST(KdTrace, ReportsStats) {
   EXPECT_EQ(kd->stats().primitive_count, 1000u);
   EXPECT_EQ(make_accel(test_device(), "kdtree:depth=20,ct=10,ci=30,empty=0.5", g)->name(), "kdtree");
   EXPECT_EQ(make_accel(test_device(), "bsp:depth=12,leaf=3", g)->name(), "bsp");
+}
+
+// The packet kernel (kernels/accel/kdtree_packet.cl) on the same tree:
+// "kdtree-packet" traces every call in packets of 8 rays.
+std::unique_ptr<Accel> kd_packets(const Geometry& g, const KdTreeConfig& config = {},
+                                  Precision level = Precision::robust) {
+  return make_kdtree(test_device(), g, config, AccelConfig{level, {}}, "kdtree-packet", KdTraversal::packet);
+}
+
+// Rays from one eye through a width x height grid over the geometry's box
+// (pixel order): coherent packets.
+std::vector<Ray> eye_rays(const Geometry& g, std::uint32_t width, std::uint32_t height) {
+  Aabb box = g.bounds();
+  glm::vec3 c = box.center(), e = box.extent();
+  float size = std::max(e.x, e.y);
+  glm::vec3 eye = c + glm::vec3(0.15f * e.x, 0.1f * e.y, 2.0f * size);
+  std::vector<Ray> rays;
+  for (std::uint32_t y = 0; y < height; ++y)
+    for (std::uint32_t x = 0; x < width; ++x) {
+      glm::vec3 target = c + size * glm::vec3((x + 0.5f) / width - 0.5f, 0.5f - (y + 0.5f) / height, 0.0f);
+      glm::vec3 d = glm::normalize(target - eye);
+      rays.push_back({eye.x, eye.y, eye.z, d.x, d.y, d.z, 0.0f, INFINITY});
+    }
+  return rays;
+}
+
+TEST(KdPacket, IsRegisteredAndTracesEveryCallInPackets) {
+  Geometry g = random_soup(300, 21);
+  auto packets = make_accel(test_device(), "kdtree-packet:ct=10,depth=20", g);
+  EXPECT_EQ(packets->name(), "kdtree-packet");
+  EXPECT_EQ(packets->rays_per_work_item(Coherence::incoherent), 8u);
+  auto kd = make_accel(test_device(), "kdtree:ct=10,depth=20", g);
+  EXPECT_EQ(kd->rays_per_work_item(Coherence::incoherent), 1u);
+  EXPECT_EQ(kd->rays_per_work_item(Coherence::coherent), 8u);
+  EXPECT_EQ(make_accel(test_device(), "bsp", g)->rays_per_work_item(Coherence::coherent), 1u);
+  EXPECT_EQ(packets->stats().node_count, kd->stats().node_count);  // the same tree
+}
+
+// Random rays (every lane of a packet in its own octant: mixed direction
+// signs on every split axis) and split-plane rays (in planes, on planes,
+// axis-parallel with +0 / -0), a count that leaves a partial packet.
+TEST(KdPacket, MatchesBruteForceOnSoupsAndSplitPlaneRays) {
+  Geometry g = soup_and_spheres(600, 25);
+  KdTreeConfig classic;
+  classic.batch = 1;
+  classic.traversal_cost = 30.0;
+  for (const KdTreeConfig& config : {KdTreeConfig{}, classic}) {
+    KdTree t = build_kdtree(g, config);
+    std::vector<Ray> rays = random_rays(g, 603, 26);
+    std::vector<Ray> planes = split_plane_rays(t, 27, 1203);
+    rays.insert(rays.end(), planes.begin(), planes.end());
+    for (Precision level : test_precisions()) expect_same_as_brute(*kd_packets(g, config, level), g, rays, level);
+  }
+}
+
+TEST(KdPacket, MatchesBruteForceOnTheBunny) {
+  Geometry g = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
+  validate(g);
+  std::vector<Ray> rays = gather<Ray>(eye_rays(g, 96, 96), tile_order(96, 96));  // coherent packets
+  std::vector<Ray> random = random_rays(g, 805, 44);
+  rays.insert(rays.end(), random.begin(), random.end());
+  std::vector<Ray> planes = split_plane_rays(build_kdtree(g), 45, 803);
+  rays.insert(rays.end(), planes.begin(), planes.end());
+  expect_same_as_brute(*kd_packets(g), g, rays, Precision::robust, false);
+  expect_same_as_brute(*kd_packets(g, {}, Precision::exact), g, rays, Precision::exact, false);
+}
+
+// Coherent calls on "kdtree" take the packet kernel and answer as its
+// single-ray calls do: the same t bit for bit, the same occlusion.
+TEST(KdPacket, CoherentCallsMatchIncoherentOnes) {
+  Geometry g = soup_and_spheres(2000, 31);
+  auto kd = make_accel(test_device(), "kdtree", g);
+  std::vector<Ray> rays = gather<Ray>(eye_rays(g, 64, 64), tile_order(64, 64));
+  std::vector<Ray> random = random_rays(g, 301, 32);
+  rays.insert(rays.end(), random.begin(), random.end());
+  for (Query q : {Query::closest, Query::any}) {
+    auto single = run_query(*kd, rays, q);
+    auto packed = run_query(*kd, rays, q, Coherence::coherent);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i)
+      if ((single[i].prim < 0) != (packed[i].prim < 0) ||
+          (q == Query::closest && std::memcmp(&single[i].t, &packed[i].t, sizeof(float)) != 0))
+        ++differ;
+    EXPECT_EQ(differ, 0u) << (q == Query::closest ? "closest" : "any") << " of " << rays.size();
+  }
+}
+
+// A flat scene crossed straight down with +0 / -0 components side by side
+// in one packet, through shared edges and vertices on split planes.
+TEST(KdPacket, FlatSceneWithSignedZerosInOnePacket) {
+  Geometry g;
+  g.source = "flat grid";
+  const int n = 16;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) g.vertices.push_back({i / float(n), j / float(n), 0.25f});
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      std::uint32_t v = j * (n + 1) + i;
+      g.triangles.push_back({v, v + 1, v + n + 2});
+      g.triangles.push_back({v, v + n + 2, v + n + 1});
+    }
+  std::vector<Ray> rays = split_plane_rays(build_kdtree(g), 28, 901);
+  std::mt19937 rng(29);
+  std::uniform_int_distribution<int> k(0, n);
+  for (int i = 0; i < 301; ++i) {
+    float x = k(rng) / float(n), y = (k(rng) + 0.5f * (i % 2)) / float(n);
+    float zero = (i % 3) ? 0.0f : -0.0f;
+    rays.push_back({x, y, (i % 5) ? 1.0f : -1.0f, zero, (i % 4) ? -0.0f : 0.0f, (i % 5) ? -1.0f : 1.0f, 0.0f,
+                    INFINITY});
+  }
+  for (Precision level : test_precisions()) expect_same_as_brute(*kd_packets(g, {}, level), g, rays, level);
+}
+
+// Ray counts 1 .. 17 leave partial packets; invalid rays share packets with
+// valid ones; the hits past ray_count stay untouched.
+TEST(KdPacket, PartialPacketsAndInvalidRays) {
+  Geometry g = random_soup(400, 33);
+  auto packets = kd_packets(g);
+  auto brute = make_brute(test_device(), g, AccelConfig{Precision::robust, {}});
+  std::vector<Ray> rays = random_rays(g, 24, 34);
+  rays[1].dx = std::numeric_limits<float>::quiet_NaN();
+  rays[3].dx = rays[3].dy = rays[3].dz = 0.0f;
+  rays[4].tmin = 2.0f;
+  rays[4].tmax = 1.0f;
+  const Device& device = test_device();
+  for (std::size_t count = 1; count <= 17; ++count) {
+    SCOPED_TRACE("ray_count " + std::to_string(count));
+    cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), "test rays");
+    std::vector<Hit> hits(rays.size(), Hit{-7.0f, -7.0f, -7.0f, -7});
+    cl::Buffer hit_buffer = device.upload(hits.data(), hits.size() * sizeof(Hit), "test hits");
+    packets->trace(Query::closest, ray_buffer, hit_buffer, count).wait();
+    device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data());
+    auto expected = run_query(*brute, std::vector<Ray>(rays.begin(), rays.begin() + static_cast<long>(count)),
+                              Query::closest);
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+      if (i < count) {
+        EXPECT_EQ(hits[i].prim >= 0, expected[i].prim >= 0) << "ray " << i;
+        if (expected[i].prim >= 0) EXPECT_EQ(hits[i].t, expected[i].t) << "ray " << i;
+      } else {
+        EXPECT_EQ(hits[i].prim, -7) << "hit " << i << " written past ray_count";
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -20,116 +20,10 @@
  *
  * Stack bound: as in accel/bvh.cl (a node pushes at most its children and
  * pops one), so the host's RTCL_STACK_SIZE is valid here too. */
-#include "shared/trace.h"
+#include "shared/packet.h"
 
 #ifndef RTCL_STACK_SIZE
 #define RTCL_STACK_SIZE 64
-#endif
-
-/* Per-packet constants: the TraceRay of each lane, in float8/int8 lanes.
- * active: lanes with a traceable ray (trace_ray_setup's conditions). */
-typedef struct TracePacket {
-  float8 ox, oy, oz, tmin;
-  float8 ix, iy, iz;
-  int8 pos_x, pos_y, pos_z;  /* reciprocal direction >= 0: lower plane is the entry plane */
-  int8 kx1, kx2, ky1, ky2, kz1, kz2; /* kx == 1, kx == 2, ... (axis permutation) */
-  float8 sx, sy, sz;
-  float8 okx, oky, okz;
-  float8 dkx, dky, dkz; /* direction, permuted */
-  float8 dx, dy, dz;
-  float8 tmax;
-  int8 active;
-} TracePacket;
-
-/* Lane-wise a[k] for a per-lane axis index given as masks k == 1, k == 2. */
-inline float8 rtcl_pick_axis(float8 x, float8 y, float8 z, int8 k1, int8 k2) {
-  return select(select(x, y, k1), z, k2);
-}
-
-inline void packet_setup(global const Ray* rays, uint first, uint ray_count, TracePacket* p, float8* tmax) {
-  float lanes[8][8];  /* [field][lane] */
-  int valid[8];
-  for (int l = 0; l < 8; ++l) {
-    uint i = first + (uint)l;
-    Ray r;
-    if (i < ray_count) {
-      r = rays[i];
-    } else { /* padding: an untraceable ray (zero direction) */
-      r.ox = r.oy = r.oz = r.dx = r.dy = r.dz = 0.0f;
-      r.tmin = 0.0f;
-      r.tmax = -1.0f;
-    }
-    lanes[0][l] = r.ox; lanes[1][l] = r.oy; lanes[2][l] = r.oz;
-    lanes[3][l] = r.dx; lanes[4][l] = r.dy; lanes[5][l] = r.dz;
-    lanes[6][l] = r.tmin; lanes[7][l] = r.tmax;
-    valid[l] = -rtcl_ray_valid(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, r.tmin, r.tmax);
-  }
-  float8 ox = vload8(0, lanes[0]), oy = vload8(0, lanes[1]), oz = vload8(0, lanes[2]);
-  float8 dx = vload8(0, lanes[3]), dy = vload8(0, lanes[4]), dz = vload8(0, lanes[5]);
-  float8 tmin = vload8(0, lanes[6]);
-  *tmax = vload8(0, lanes[7]);
-  float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
-  /* kz = dominant axis, ties as in trace_ray_setup */
-  int8 kz = select(select((int8)(2), (int8)(1), ay > az), select((int8)(2), (int8)(0), ax > az), ax > ay);
-  float8 adk = select(select(az, ay, kz == 1), ax, kz == 0);
-  p->active = (adk > 0.0f) & vload8(0, valid);
-  p->tmax = *tmax;
-  int8 kx = select(kz + 1, (int8)(0), kz == 2);
-  int8 ky = select(kx + 1, (int8)(0), kx == 2);
-  float8 dkz = rtcl_pick_axis(dx, dy, dz, kz == 1, kz == 2);
-  int8 flip = dkz < 0.0f;
-  int8 tx = select(kx, ky, flip), ty = select(ky, kx, flip);
-  p->kx1 = tx == 1; p->kx2 = tx == 2;
-  p->ky1 = ty == 1; p->ky2 = ty == 2;
-  p->kz1 = kz == 1; p->kz2 = kz == 2;
-  p->ox = ox; p->oy = oy; p->oz = oz; p->tmin = tmin;
-  p->dx = dx; p->dy = dy; p->dz = dz;
-  p->ix = 1.0f / dx;
-  p->iy = 1.0f / dy;
-  p->iz = 1.0f / dz;
-  p->pos_x = p->ix >= 0.0f;
-  p->pos_y = p->iy >= 0.0f;
-  p->pos_z = p->iz >= 0.0f;
-  p->sz = 1.0f / dkz;
-  p->sx = rtcl_pick_axis(dx, dy, dz, p->kx1, p->kx2) / dkz;
-  p->sy = rtcl_pick_axis(dx, dy, dz, p->ky1, p->ky2) / dkz;
-  p->okx = rtcl_pick_axis(ox, oy, oz, p->kx1, p->kx2);
-  p->oky = rtcl_pick_axis(ox, oy, oz, p->ky1, p->ky2);
-  p->okz = rtcl_pick_axis(ox, oy, oz, p->kz1, p->kz2);
-  p->dkx = rtcl_pick_axis(dx, dy, dz, p->kx1, p->kx2);
-  p->dky = rtcl_pick_axis(dx, dy, dz, p->ky1, p->ky2);
-  p->dkz = dkz;
-}
-
-/* Closest-hit state of the packet, lane = ray: t_best (and at the exact
- * level t_exact) as in HitState; the winning edge functions are kept and
- * turned into (u, v) at the end, as intersect_triangle_lanes does for its
- * winner (fast and exact keep u, v themselves, with det = 1). */
-typedef struct PacketHits {
-  float8 t_best, det, V, W;
-  int8 prim;
-#ifdef RTCL_PRECISION_EXACT
-  double t_exact[8];
-#endif
-} PacketHits;
-
-/* Lane l as an int8 mask. */
-inline int8 rtcl_lane_mask(int l) { return (int8)(0, 1, 2, 3, 4, 5, 6, 7) == (int8)(l); }
-
-#ifdef RTCL_PRECISION_EXACT
-/* Records a double-precision hit of lane l when it beats the lane's best
- * (exact_better). Returns 1 if it did. */
-inline int packet_exact_record(PacketHits* h, int l, double t, int prim, float tmin, float tmax, float u, float v) {
-  if (!exact_better(t, prim, h->t_exact[l], rtcl_lane_i(h->prim, l), tmin, tmax)) return 0;
-  int8 m = rtcl_lane_mask(l);
-  h->t_exact[l] = t;
-  h->t_best = select(h->t_best, (float8)(convert_float_rtp(t)), m);
-  h->det = select(h->det, (float8)(1.0f), m);
-  h->V = select(h->V, (float8)(u), m);
-  h->W = select(h->W, (float8)(v), m);
-  h->prim = select(h->prim, (int8)(prim), m);
-  return 1;
-}
 #endif
 
 /* Child c's box against the packet over [tmin, t_best]: intersect_boxes8's
@@ -150,120 +44,11 @@ inline float8 packet_box(global const Bvh8Node* node, int c, const TracePacket* 
   return select((float8)(NAN), tn, mask & (tn <= tf));
 }
 
-/* Triangle k of a block against the packet's rays in `mask`:
- * intersect_triangle_lanes's arithmetic per lane. Returns the lanes it hits
- * in [tmin, t_best) (exact: by exact_better) and records those hits. */
+/* Triangle k of a block against the packet (packet_triangle_at). */
 inline int8 packet_triangle(global const TriangleBlock* block, int k, const TracePacket* p, PacketHits* h,
                             int8 mask) {
-  /* vertex j's coordinates on each ray's permuted axes */
-  float8 v[3][3];
-  for (int j = 0; j < 3; ++j) {
-    float8 x = (float8)(block->v[j][0][k]), y = (float8)(block->v[j][1][k]), z = (float8)(block->v[j][2][k]);
-    v[j][0] = rtcl_pick_axis(x, y, z, p->kx1, p->kx2);
-    v[j][1] = rtcl_pick_axis(x, y, z, p->ky1, p->ky2);
-    v[j][2] = rtcl_pick_axis(x, y, z, p->kz1, p->kz2);
-  }
-#ifdef RTCL_PRECISION_FAST
-  float8 t, u, w;
-  int8 ok = mask & rtcl_moller_trumbore8(v[0][0], v[0][1], v[0][2], v[1][0], v[1][1], v[1][2], v[2][0], v[2][1],
-                                         v[2][2], p->okx, p->oky, p->okz, p->dkx, p->dky, p->dkz, p->tmin,
-                                         h->t_best, &t, &u, &w);
-  if (!rtcl_any8(ok)) return ok;
-  h->t_best = select(h->t_best, t, ok);
-  h->det = select(h->det, (float8)(1.0f), ok);
-  h->V = select(h->V, u, ok);
-  h->W = select(h->W, w, ok);
-  h->prim = select(h->prim, (int8)(block->prim[k]), ok);
-  return ok;
-#else
-  float8 az = v[0][2] - p->okz, bz = v[1][2] - p->okz, cz = v[2][2] - p->okz;
-  float8 ax = v[0][0] - p->okx - p->sx * az, ay = v[0][1] - p->oky - p->sy * az;
-  float8 bx = v[1][0] - p->okx - p->sx * bz, by = v[1][1] - p->oky - p->sy * bz;
-  float8 cx = v[2][0] - p->okx - p->sx * cz, cy = v[2][1] - p->oky - p->sy * cz;
-  float8 U = rtcl_edge8(cx, cy, bx, by);
-  float8 V = rtcl_edge8(ax, ay, cx, cy);
-  float8 W = rtcl_edge8(bx, by, ax, ay);
-#ifdef RTCL_PRECISION_EXACT
-  int8 cand = mask & rtcl_exact_triangle_candidates(ax, ay, az, bx, by, bz, cx, cy, cz, U, V, W, p->sz, p->tmin,
-                                                    h->t_best);
-  if (!rtcl_any8(cand)) return cand;
-  int prim = block->prim[k];
-  int hit[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-  for (int l = 0; l < 8; ++l) {
-    if (!rtcl_lane_i(cand, l)) continue;
-    float u = 0.0f, w = 0.0f;
-    double t = exact_triangle(rtcl_lane(v[0][0], l), rtcl_lane(v[0][1], l), rtcl_lane(v[0][2], l),
-                              rtcl_lane(v[1][0], l), rtcl_lane(v[1][1], l), rtcl_lane(v[1][2], l),
-                              rtcl_lane(v[2][0], l), rtcl_lane(v[2][1], l), rtcl_lane(v[2][2], l),
-                              rtcl_lane(p->okx, l), rtcl_lane(p->oky, l), rtcl_lane(p->okz, l),
-                              exact_shear(rtcl_lane(p->dkx, l), rtcl_lane(p->dky, l), rtcl_lane(p->dkz, l)), &u, &w);
-    hit[l] = -packet_exact_record(h, l, t, prim, rtcl_lane(p->tmin, l), rtcl_lane(p->tmax, l), u, w);
-  }
-  return vload8(0, hit);
-#else
-  int8 inside = ((U >= 0.0f) & (V >= 0.0f) & (W >= 0.0f)) | ((U <= 0.0f) & (V <= 0.0f) & (W <= 0.0f));
-  float8 det = U + V + W;
-  float8 T = p->sz * (U * az + V * bz + W * cz);
-  float8 t = T / det;
-  int8 ok = mask & inside & (det != 0.0f) & (t >= p->tmin) & (t < h->t_best);
-  if (!rtcl_any8(ok)) return ok;
-  h->t_best = select(h->t_best, t, ok);
-  h->det = select(h->det, det, ok);
-  h->V = select(h->V, V, ok);
-  h->W = select(h->W, W, ok);
-  h->prim = select(h->prim, (int8)(block->prim[k]), ok);
-  return ok;
-#endif
-#endif
+  return packet_triangle_at(&block->v[0][0][k], RTCL_BLOCK_WIDTH, block->prim[k], p, h, mask);
 }
-
-#ifdef RTCL_HAS_SPHERES
-/* Sphere k of a block against the packet: intersect_sphere_lanes's
- * arithmetic per lane (Haines et al., Ray Tracing Gems ch. 7). */
-inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePacket* p, PacketHits* h, int8 mask) {
-  float r = block->r[k];
-  float8 fx = p->ox - block->cx[k];
-  float8 fy = p->oy - block->cy[k];
-  float8 fz = p->oz - block->cz[k];
-  float8 a = p->dx * p->dx + p->dy * p->dy + p->dz * p->dz;
-  float8 b = -(fx * p->dx + fy * p->dy + fz * p->dz);
-  float8 kk = b / a;
-  float8 lx = fx + kk * p->dx, ly = fy + kk * p->dy, lz = fz + kk * p->dz;
-  float8 l2 = lx * lx + ly * ly + lz * lz;
-  float8 disc = a * (r * r - l2);
-#ifdef RTCL_PRECISION_EXACT
-  int8 cand = mask & (disc >= -(RTCL_EXACT_EDGE_ULPS * FLT_EPSILON) * a * (r * r + l2 + fx * fx + fy * fy + fz * fz));
-  if (!rtcl_any8(cand)) return cand;
-  int prim = block->prim[k];
-  int hit[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-  for (int l = 0; l < 8; ++l) {
-    if (!rtcl_lane_i(cand, l)) continue;
-    float tmin = rtcl_lane(p->tmin, l), tmax = rtcl_lane(p->tmax, l);
-    double t = exact_sphere(block->cx[k], block->cy[k], block->cz[k], r, rtcl_lane(p->ox, l), rtcl_lane(p->oy, l),
-                            rtcl_lane(p->oz, l), rtcl_lane(p->dx, l), rtcl_lane(p->dy, l), rtcl_lane(p->dz, l), tmin,
-                            tmax);
-    hit[l] = -packet_exact_record(h, l, t, prim, tmin, tmax, 0.0f, 0.0f);
-  }
-  return vload8(0, hit);
-#endif
-  int8 real = disc >= 0.0f;
-  float8 c = fx * fx + fy * fy + fz * fz - r * r;
-  float8 q = b + copysign(sqrt(fmax(disc, 0.0f)), b);
-  float8 t0 = c / q, t1 = q / a;
-  float8 tn = fmin(t0, t1), tf = fmax(t0, t1);
-  int8 ok_n = real & (tn >= p->tmin) & (tn < h->t_best);
-  int8 ok_f = real & (tf >= p->tmin) & (tf < h->t_best);
-  float8 t = select(tf, tn, ok_n);
-  int8 ok = mask & (ok_n | ok_f);
-  if (!rtcl_any8(ok)) return ok;
-  h->t_best = select(h->t_best, t, ok);
-  h->det = select(h->det, (float8)(1.0f), ok);
-  h->V = select(h->V, (float8)(0.0f), ok);
-  h->W = select(h->W, (float8)(0.0f), ok);
-  h->prim = select(h->prim, (int8)(block->prim[k]), ok);
-  return ok;
-}
-#endif
 
 /* Traverses the packet. Any hit: a ray leaves the packet at its first hit;
  * the traversal ends when every ray has. */
@@ -347,34 +132,9 @@ inline void packet_trace(global const Ray* rays, global Hit* hits, uint ray_coun
   float8 tmax;
   packet_setup(rays, first, ray_count, &p, &tmax);
   PacketHits h;
-  h.t_best = nextafter(tmax, (float8)(INFINITY));
-  h.det = (float8)(1.0f);
-  h.V = h.W = (float8)(0.0f);
-  h.prim = (int8)(-1);
-#ifdef RTCL_PRECISION_EXACT
-  for (int l = 0; l < 8; ++l) h.t_exact[l] = INFINITY;
-#endif
+  packet_hits_init(&h, tmax);
   if (rtcl_any8(p.active)) bvh_packet_traverse(&p, &h, nodes, triangles, spheres);
-  float inv_det[8], V[8], W[8], t[8];
-  int prim[8];
-  vstore8(h.t_best, 0, t);
-  vstore8(h.det, 0, inv_det);
-  vstore8(h.V, 0, V);
-  vstore8(h.W, 0, W);
-  vstore8(h.prim, 0, prim);
-  for (uint l = 0; l < 8u && first + l < ray_count; ++l) {
-    Hit out;
-    float id = 1.0f / inv_det[l];
-#ifdef RTCL_PRECISION_EXACT
-    out.t = prim[l] < 0 ? INFINITY : convert_float_rte(h.t_exact[l]);
-#else
-    out.t = prim[l] < 0 ? INFINITY : t[l];
-#endif
-    out.u = V[l] * id;
-    out.v = W[l] * id;
-    out.prim = prim[l];
-    hits[first + l] = out;
-  }
+  packet_store(&h, hits, first, ray_count);
 }
 
 kernel void RTCL_TRACE_KERNEL_NAME(bvh_packet)(global const Ray* rays, global Hit* hits, uint ray_count,

@@ -58,11 +58,8 @@
  * node at depth k holds at most k entries, and pushes at most depth(tree)
  * in all. The host refuses trees deeper than RTCL_KD_STACK
  * (src/rtcl/accel/kdtree_nodes.cpp, kKdMaxDepth). */
+#include "shared/kdtree.h"
 #include "shared/trace.h"
-
-#ifndef RTCL_KD_STACK
-#error "RTCL_KD_STACK (the deepest tree) must be defined"
-#endif
 
 /* One axis of the ray against the root box: narrows [*t0, *t1] to the
  * slab (conservatively widened, Ize 2013); a ray that does not move along
@@ -76,11 +73,6 @@ inline int kd_clip_axis(float o, float d, float inv, float lower, float upper, f
   *t1 = fmin(*t1, tf + fabs(tf) * RTCL_SLAB_WIDEN);
   return 1;
 }
-
-#define KD_EXIT_MARGIN (4.0f * RTCL_SLAB_WIDEN)
-
-/* A leaf with no references (the SAH's cut-off empty space). */
-#define KD_EMPTY(node) (((node).flags & 3u) == RTCL_KD_LEAF && (node).data == 0u)
 
 /* Tests a leaf's references refs[first .. end) (triangles, then spheres as
  * ~r): the triangles' lanes in runs of eight, the spheres in batches of

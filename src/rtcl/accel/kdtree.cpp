@@ -257,45 +257,71 @@ KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config) {
   return flatten_kd_tree(prims, *root, "kdtree", "depth=" + std::to_string(depth), config.max_alloc_bytes);
 }
 
-const StructureSpec& kdtree_structure() {
+namespace {
+
+std::vector<OptionSpec> kdtree_options() {
   static const KdTreeConfig d;
-  static const StructureSpec spec{
-      "kdtree", "SAH kd-tree: O(N log N) sorted-event build, perfect splits, [min,max] interval traversal",
-      {{"depth", OptionType::integer, std::int64_t{0}, 0, kKdMaxDepth, false,
-        "deepest leaf in splits, at most the traversal stack; 0: round(8 + 1.3 log2 N)"},
-       {"ct", OptionType::real, d.traversal_cost, 0, 1e6, true,
-        "SAH cost of one node step: higher makes shallower trees with larger leaves"},
-       {"ci", OptionType::real, d.intersection_cost, 0, 1e6, true,
-        "SAH cost of one primitive test: higher makes deeper trees with smaller leaves"},
-       {"empty", OptionType::real, d.empty_bonus, 0, 0.99, false,
-        "empty-space bonus: a split with one empty side costs (1 - empty) times its SAH cost"},
-       {"batch", OptionType::integer, std::int64_t{d.batch}, 1, 8, false,
-        "primitives per intersection test in the SAH (1: classic; 8: the kernel's float8 batch, larger leaves)"}}};
-  return spec;
+  return {{"depth", OptionType::integer, std::int64_t{0}, 0, kKdMaxDepth, false,
+           "deepest leaf in splits, at most the traversal stack; 0: round(8 + 1.3 log2 N)"},
+          {"ct", OptionType::real, d.traversal_cost, 0, 1e6, true,
+           "SAH cost of one node step: higher makes shallower trees with larger leaves"},
+          {"ci", OptionType::real, d.intersection_cost, 0, 1e6, true,
+           "SAH cost of one primitive test: higher makes deeper trees with smaller leaves"},
+          {"empty", OptionType::real, d.empty_bonus, 0, 0.99, false,
+           "empty-space bonus: a split with one empty side costs (1 - empty) times its SAH cost"},
+          {"batch", OptionType::integer, std::int64_t{d.batch}, 1, 8, false,
+           "primitives per intersection test in the SAH (1: classic; 8: the kernel's float8 batch, larger leaves)"}};
 }
 
-std::unique_ptr<Accel> make_kdtree(const Device& device, const Geometry& geometry, const KdTreeConfig& config,
-                                   const AccelConfig& accel_config) {
-  return build_kd_accel(
-      device, geometry, "kdtree",
-      [&](std::size_t max_alloc_bytes) {
-        KdTreeConfig limited = config;
-        if (!limited.max_alloc_bytes) limited.max_alloc_bytes = max_alloc_bytes;
-        return build_kdtree(geometry, limited);
-      },
-      accel_config);
-}
-
-std::unique_ptr<Accel> make_kdtree_accel(const Device& device, const Geometry& geometry,
-                                         const AccelConfig& config) {
-  AccelOptions o = resolve_options(kdtree_structure(), config.options, "--accel kdtree");
+std::unique_ptr<Accel> make_kdtree_from(const StructureSpec& spec, KdTraversal traversal, const Device& device,
+                                        const Geometry& geometry, const AccelConfig& config) {
+  AccelOptions o = resolve_options(spec, config.options, "--accel " + spec.name);
   KdTreeConfig kd;
   kd.depth = static_cast<int>(o.integer("depth"));
   kd.traversal_cost = o.real("ct");
   kd.intersection_cost = o.real("ci");
   kd.empty_bonus = o.real("empty");
   kd.batch = static_cast<unsigned>(o.integer("batch"));
-  return make_kdtree(device, geometry, kd, config);
+  return make_kdtree(device, geometry, kd, config, spec.name, traversal);
+}
+
+}  // namespace
+
+const StructureSpec& kdtree_structure() {
+  static const StructureSpec spec{
+      "kdtree",
+      "SAH kd-tree: O(N log N) sorted-event build, perfect splits, [min,max] interval traversal; packets of 8 rays "
+      "for coherent calls",
+      kdtree_options()};
+  return spec;
+}
+
+const StructureSpec& kdtree_packet_structure() {
+  static const StructureSpec spec{"kdtree-packet", "the kdtree, always traced in packets of 8 rays (for measuring)",
+                                  kdtree_options()};
+  return spec;
+}
+
+std::unique_ptr<Accel> make_kdtree(const Device& device, const Geometry& geometry, const KdTreeConfig& config,
+                                   const AccelConfig& accel_config, const std::string& name, KdTraversal traversal) {
+  return build_kd_accel(
+      device, geometry, name,
+      [&](std::size_t max_alloc_bytes) {
+        KdTreeConfig limited = config;
+        if (!limited.max_alloc_bytes) limited.max_alloc_bytes = max_alloc_bytes;
+        return build_kdtree(geometry, limited);
+      },
+      accel_config, traversal);
+}
+
+std::unique_ptr<Accel> make_kdtree_accel(const Device& device, const Geometry& geometry,
+                                         const AccelConfig& config) {
+  return make_kdtree_from(kdtree_structure(), KdTraversal::by_coherence, device, geometry, config);
+}
+
+std::unique_ptr<Accel> make_kdtree_packet_accel(const Device& device, const Geometry& geometry,
+                                                const AccelConfig& config) {
+  return make_kdtree_from(kdtree_packet_structure(), KdTraversal::packet, device, geometry, config);
 }
 
 }  // namespace rtcl

@@ -53,14 +53,22 @@ int kdtree_depth(const KdTreeConfig& config, std::size_t primitives);
 // naming the option for a bad config or a tree too large for the device.
 KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config = {});
 
-// Its registry entry: depth, ct (traversal_cost), ci (intersection_cost),
-// empty (empty_bonus).
+// Its registry entries: depth, ct (traversal_cost), ci (intersection_cost),
+// empty (empty_bonus), batch. "kdtree" traces Coherence::coherent calls in
+// packets of 8 rays (accel/kdtree_packet.cl) and the others one ray per
+// work-item (accel/kdtree.cl); "kdtree-packet", the same tree, always in
+// packets (for measuring).
 const StructureSpec& kdtree_structure();
+const StructureSpec& kdtree_packet_structure();
 
 std::unique_ptr<Accel> make_kdtree_accel(const Device& device, const Geometry& geometry, const AccelConfig& config);
+std::unique_ptr<Accel> make_kdtree_packet_accel(const Device& device, const Geometry& geometry,
+                                                const AccelConfig& config);
 
-// Builds and uploads; stats().build_ms covers build_kdtree.
+// Builds and uploads as structure `name`, traced by `traversal`;
+// stats().build_ms covers build_kdtree.
 std::unique_ptr<Accel> make_kdtree(const Device& device, const Geometry& geometry, const KdTreeConfig& config = {},
-                                   const AccelConfig& accel_config = {});
+                                   const AccelConfig& accel_config = {}, const std::string& name = "kdtree",
+                                   KdTraversal traversal = KdTraversal::by_coherence);
 
 }  // namespace rtcl

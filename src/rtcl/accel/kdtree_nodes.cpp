@@ -193,10 +193,15 @@ bool KdThreads::try_take() {
 namespace {
 
 class KdAccel final : public Accel {
+  static inline const TraceKernels kSingle{"accel/kdtree.cl"};
+  static inline const TraceKernels kPacket{"accel/kdtree_packet.cl", 8};
+
  public:
   KdAccel(const Device& device, const Geometry& geometry, const std::string& name, const KdTree& tree,
-          AccelStats stats, const AccelConfig& config)
-      : Accel(device, name, {"accel/kdtree.cl"}, std::nullopt, defines(geometry), stats, config),
+          AccelStats stats, const AccelConfig& config, KdTraversal traversal)
+      : Accel(device, name, traversal == KdTraversal::packet ? kPacket : kSingle,
+              traversal == KdTraversal::by_coherence ? std::optional(kPacket) : std::nullopt, defines(geometry),
+              stats, config),
         header_(device.upload(&tree.header, sizeof tree.header, (name + " header").c_str())),
         nodes_(device.upload(tree.nodes.data(), tree.nodes.size() * sizeof(KdNode), (name + " nodes").c_str())),
         refs_(tree.refs.empty() ? device.upload(&kNoRef, sizeof kNoRef, (name + " references").c_str())
@@ -233,8 +238,9 @@ class KdAccel final : public Accel {
 }  // namespace
 
 std::unique_ptr<Accel> make_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
-                                     const KdTree& tree, AccelStats stats, const AccelConfig& config) {
-  return std::make_unique<KdAccel>(device, geometry, name, tree, stats, config);
+                                     const KdTree& tree, AccelStats stats, const AccelConfig& config,
+                                     KdTraversal traversal) {
+  return std::make_unique<KdAccel>(device, geometry, name, tree, stats, config, traversal);
 }
 
 }  // namespace rtcl
@@ -243,7 +249,7 @@ namespace rtcl {
 
 std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
                                       const std::function<KdTree(std::size_t max_alloc_bytes)>& build,
-                                      const AccelConfig& config) {
+                                      const AccelConfig& config, KdTraversal traversal) {
   auto start = std::chrono::steady_clock::now();
   GeometryReport report = validate(geometry);
   KdTree tree = build(device.info().max_alloc_bytes);
@@ -254,7 +260,7 @@ std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geom
   stats.zero_area_skipped = report.zero_area_triangles;
   stats.node_count = tree.nodes.size() - tree.leaf_count;
   stats.leaf_count = tree.leaf_count;
-  return make_kd_accel(device, geometry, name, tree, stats, config);
+  return make_kd_accel(device, geometry, name, tree, stats, config, traversal);
 }
 
 }  // namespace rtcl

@@ -117,15 +117,25 @@ class KdThreads {
   std::atomic<int> spare_;
 };
 
-// Uploads the tree as structure `name` (the kernels of accel/kdtree.cl).
+// Which kernel traces a call: accel/kdtree.cl (one ray per work-item) or
+// accel/kdtree_packet.cl (packets of 8 rays).
+enum class KdTraversal {
+  single,        // always one ray per work-item
+  by_coherence,  // packets for Coherence::coherent calls, single rays otherwise
+  packet,        // always packets (for measuring)
+};
+
+// Uploads the tree as structure `name` (the kernels of accel/kdtree.cl and
+// accel/kdtree_packet.cl, chosen by `traversal`).
 std::unique_ptr<Accel> make_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
-                                     const KdTree& tree, AccelStats stats, const AccelConfig& config);
+                                     const KdTree& tree, AccelStats stats, const AccelConfig& config,
+                                     KdTraversal traversal = KdTraversal::single);
 
 // Validates the geometry, builds with build(max_alloc_bytes), the device's
 // largest buffer, and uploads as `name`; stats().build_ms covers the
 // validation and the build.
 std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
                                       const std::function<KdTree(std::size_t max_alloc_bytes)>& build,
-                                      const AccelConfig& config);
+                                      const AccelConfig& config, KdTraversal traversal = KdTraversal::single);
 
 }  // namespace rtcl

@@ -39,6 +39,7 @@ const std::vector<Entry>& registry() {
       {octree_r_structure(), make_octree_r_accel},
       {bsp_structure(), make_bsp_accel},
       {kdtree_structure(), make_kdtree_accel},
+      {kdtree_packet_structure(), make_kdtree_packet_accel},
   };
   return entries;
 }
