@@ -95,7 +95,8 @@ TEST(BvhPacket, IsRegistered) {
 
 // Which kernel a call gets: packets for coherent calls where the structure
 // has a packet kernel (every BVH but "bvh-mixed", whose sphere filter the
-// packet kernel lacks), for every call on "bvh-packet", else one ray.
+// packet kernel lacks, and the kd-tree), for every call on "bvh-packet" and
+// "kdtree-packet", else one ray.
 TEST(BvhPacket, CoherenceSelectsTheKernel) {
   Geometry g = random_soup(200, 81);
   for (const std::string& name : accel_names()) {
