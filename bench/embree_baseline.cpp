@@ -60,36 +60,17 @@ RTCRay to_embree(const Ray& r) {
   return ray;
 }
 
-void closest(RTCScene scene, const Ray* rays, Hit* hits, std::size_t begin, std::size_t end) {
+// Answers the prepared records [begin, end) in place.
+void closest(RTCScene scene, RTCRayHit* records, std::size_t begin, std::size_t end) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  for (std::size_t i = begin; i < end; ++i) {
-    const Ray& r = rays[i];
-    RTCRayHit rh;
-    rh.ray = to_embree(r);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene, &context, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
-      hits[i] = Hit{std::numeric_limits<float>::infinity(), 0.0f, 0.0f, -1};
-    else
-      hits[i] = Hit{rh.ray.tfar, rh.hit.u, rh.hit.v, static_cast<rtcl_i32>(rh.hit.primID)};
-  }
+  for (std::size_t i = begin; i < end; ++i) rtcIntersect1(scene, &context, &records[i]);
 }
 
-void occluded(RTCScene scene, const Ray* rays, Hit* hits, std::size_t begin, std::size_t end) {
+void occluded(RTCScene scene, RTCRayHit* records, std::size_t begin, std::size_t end) {
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
-  for (std::size_t i = begin; i < end; ++i) {
-    const Ray& r = rays[i];
-    RTCRay ray = to_embree(r);
-    rtcOccluded1(scene, &context, &ray);
-    // rtcOccluded1 sets tfar = -inf when the ray is blocked.
-    if (ray.tfar == -std::numeric_limits<float>::infinity())
-      hits[i] = Hit{r.tmin, 0.0f, 0.0f, 0};
-    else
-      hits[i] = Hit{std::numeric_limits<float>::infinity(), 0.0f, 0.0f, -1};
-  }
+  for (std::size_t i = begin; i < end; ++i) rtcOccluded1(scene, &context, &records[i].ray);
 }
 
 }  // namespace
@@ -150,21 +131,61 @@ void EmbreeScene::release() {
   buffers_ = nullptr;
 }
 
-void EmbreeScene::trace(Query query, const Ray* rays, Hit* hits, std::size_t count, unsigned threads) const {
+struct EmbreeScene::Prepared {
+  Query query = Query::closest;
+  std::vector<RTCRayHit> records;
+};
+
+void EmbreeScene::prepare(Query query, const Ray* rays, std::size_t count) const {
+  if (!prepared_) prepared_ = std::make_shared<Prepared>();
+  prepared_->query = query;
+  prepared_->records.resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    RTCRayHit& rh = prepared_->records[i];
+    rh.ray = to_embree(rays[i]);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  }
+}
+
+void EmbreeScene::trace_prepared(unsigned threads) const {
   RTCScene scene = static_cast<RTCScene>(scene_);
-  auto kernel = query == Query::closest ? closest : occluded;
+  auto kernel = prepared_->query == Query::closest ? closest : occluded;
+  RTCRayHit* records = prepared_->records.data();
+  const std::size_t count = prepared_->records.size();
   std::atomic<std::size_t> next{0};
   auto work = [&] {
     for (;;) {
       std::size_t begin = next.fetch_add(block_rays);
       if (begin >= count) return;
-      kernel(scene, rays, hits, begin, std::min(count, begin + block_rays));
+      kernel(scene, records, begin, std::min(count, begin + block_rays));
     }
   };
   std::vector<std::thread> helpers;
   for (unsigned t = 1; t < std::max(threads, 1u); ++t) helpers.emplace_back(work);
   work();
   for (auto& h : helpers) h.join();
+}
+
+void EmbreeScene::answers(Hit* hits) const {
+  const float inf = std::numeric_limits<float>::infinity();
+  const std::vector<RTCRayHit>& records = prepared_->records;
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const RTCRayHit& rh = records[i];
+    if (prepared_->query == Query::any)  // rtcOccluded1 sets tfar = -inf when the ray is blocked
+      hits[i] = rh.ray.tfar == -inf ? Hit{rh.ray.tnear, 0.0f, 0.0f, 0} : Hit{inf, 0.0f, 0.0f, -1};
+    else if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+      hits[i] = Hit{inf, 0.0f, 0.0f, -1};
+    else
+      hits[i] = Hit{rh.ray.tfar, rh.hit.u, rh.hit.v, static_cast<rtcl_i32>(rh.hit.primID)};
+  }
+}
+
+void EmbreeScene::trace(Query query, const Ray* rays, Hit* hits, std::size_t count, unsigned threads) const {
+  prepare(query, rays, count);
+  trace_prepared(threads);
+  answers(hits);
+  prepared_.reset();
 }
 
 std::string embree_version() {

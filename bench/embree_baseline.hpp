@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <string>
 
 #include "rtcl/accel/accel.hpp"
@@ -39,12 +40,24 @@ class EmbreeScene {
   // data, so an occluded ray gets t = tmin, prim = 0, u = v = 0. Misses as Hit.
   void trace(Query query, const Ray* rays, Hit* hits, std::size_t count, unsigned threads) const;
 
+  // The same in three steps, so that only the traversal is timed, as
+  // Embree's own framing has it (rays built before the loop, answers read
+  // after it; rtcl's kernel time likewise excludes upload and read-back):
+  // prepare() converts the rays into Embree's records, trace_prepared()
+  // answers them in place on `threads` host threads, answers() converts
+  // them into Hit records. prepare() again before each trace_prepared().
+  void prepare(Query query, const Ray* rays, std::size_t count) const;
+  void trace_prepared(unsigned threads) const;
+  void answers(Hit* hits) const;
+
  private:
   void build(const Geometry& geometry, EmbreeQuality quality);
   void release();
   struct Buffers;
+  struct Prepared;
   void* scene_ = nullptr;  // RTCScene
   Buffers* buffers_ = nullptr;
+  mutable std::shared_ptr<Prepared> prepared_;
   double build_ms_ = 0.0;
   std::size_t bytes_ = 0;
 };
