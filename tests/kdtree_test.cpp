@@ -141,12 +141,11 @@ TEST(KdTrace, MatchesBruteForceOnTheBunny) {
   expect_same_as_brute(*make_kdtree(test_device(), g), g, rays, Precision::robust, false);
 }
 
-// A scene flat along z (every split on z would be useless), a grid of
-// triangles with shared edges on the split planes.
-TEST(KdTrace, FlatSceneAndSharedEdgesOnSplitPlanes) {
+// An n x n grid of cells over the unit square in the plane z = 0.25, two
+// triangles each, sharing edges and vertices.
+Geometry flat_grid(int n) {
   Geometry g;
   g.source = "flat grid";
-  const int n = 16;
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) g.vertices.push_back({i / float(n), j / float(n), 0.25f});
   for (int j = 0; j < n; ++j)
@@ -155,6 +154,14 @@ TEST(KdTrace, FlatSceneAndSharedEdgesOnSplitPlanes) {
       g.triangles.push_back({v, v + 1, v + n + 2});
       g.triangles.push_back({v, v + n + 2, v + n + 1});
     }
+  return g;
+}
+
+// A scene flat along z (every split on z would be useless), a grid of
+// triangles with shared edges on the split planes.
+TEST(KdTrace, FlatSceneAndSharedEdgesOnSplitPlanes) {
+  const int n = 16;
+  Geometry g = flat_grid(n);
   KdTree t = build_kdtree(g);
   std::vector<Ray> rays = split_plane_rays(t, 8, 900);
   std::mt19937 rng(9);
@@ -269,17 +276,8 @@ TEST(KdPacket, CoherentCallsMatchIncoherentOnes) {
 // A flat scene crossed straight down with +0 / -0 components side by side
 // in one packet, through shared edges and vertices on split planes.
 TEST(KdPacket, FlatSceneWithSignedZerosInOnePacket) {
-  Geometry g;
-  g.source = "flat grid";
   const int n = 16;
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) g.vertices.push_back({i / float(n), j / float(n), 0.25f});
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      std::uint32_t v = j * (n + 1) + i;
-      g.triangles.push_back({v, v + 1, v + n + 2});
-      g.triangles.push_back({v, v + n + 2, v + n + 1});
-    }
+  Geometry g = flat_grid(n);
   std::vector<Ray> rays = split_plane_rays(build_kdtree(g), 28, 901);
   std::mt19937 rng(29);
   std::uniform_int_distribution<int> k(0, n);

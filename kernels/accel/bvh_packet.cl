@@ -124,21 +124,6 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
   }
 }
 
-inline void packet_trace(global const Ray* rays, global Hit* hits, uint ray_count, global const Bvh8Node* nodes,
-                         global const TriangleBlock* triangles, global const SphereBlock* spheres) {
-  uint first = get_global_id(0) * 8u;
-  if (first >= ray_count) return;
-  TracePacket p;
-  float8 tmax;
-  packet_setup(rays, first, ray_count, &p, &tmax);
-  PacketHits h;
-  packet_hits_init(&h, tmax);
-  if (rtcl_any8(p.active)) bvh_packet_traverse(&p, &h, nodes, triangles, spheres);
-  packet_store(&h, hits, first, ray_count);
-}
-
-kernel void RTCL_TRACE_KERNEL_NAME(bvh_packet)(global const Ray* rays, global Hit* hits, uint ray_count,
-                                               global const Bvh8Node* nodes, global const TriangleBlock* triangles,
-                                               global const SphereBlock* spheres) {
-  packet_trace(rays, hits, ray_count, nodes, triangles, spheres);
-}
+#define BVH_PACKET_PARAMS global const Bvh8Node *nodes, global const TriangleBlock *triangles, global const SphereBlock *spheres
+#define BVH_PACKET_ARGS nodes, triangles, spheres
+RTCL_PACKET_KERNELS(bvh_packet, BVH_PACKET_PARAMS, BVH_PACKET_ARGS)

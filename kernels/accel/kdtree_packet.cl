@@ -61,13 +61,13 @@ inline int kdp_count(int8 m) {
   return b.x + b.y;
 }
 
-__attribute__((noinline)) void kdtree_packet_traverse(const TracePacket* p, float8 tmax, PacketHits* h,
+__attribute__((noinline)) void kdtree_packet_traverse(const TracePacket* p, PacketHits* h,
                                                       global const KdHeader* header, global const KdNode* nodes,
                                                       global const int* refs, global const float* lanes,
                                                       global const int* lane_prims,
                                                       global const SphereBlock* spheres) {
   const int lane_stride = header->lane_stride;
-  float8 t0 = p->tmin, t1 = tmax;
+  float8 t0 = p->tmin, t1 = p->tmax;
   int8 ok = p->active;
   ok &= kdp_clip_axis(p->ox, p->dx, p->ix, header->lower[0], header->upper[0], &t0, &t1);
   ok &= kdp_clip_axis(p->oy, p->dy, p->iy, header->lower[1], header->upper[1], &t0, &t1);
@@ -169,17 +169,8 @@ __attribute__((noinline)) void kdtree_packet_traverse(const TracePacket* p, floa
   }
 }
 
-kernel void RTCL_TRACE_KERNEL_NAME(kdtree_packet)(global const Ray* rays, global Hit* hits, uint ray_count,
-                                                  global const KdHeader* header, global const KdNode* nodes,
-                                                  global const int* refs, global const float* lanes,
-                                                  global const int* lane_prims, global const SphereBlock* spheres) {
-  uint first = get_global_id(0) * 8u;
-  if (first >= ray_count) return;
-  TracePacket p;
-  float8 tmax;
-  packet_setup(rays, first, ray_count, &p, &tmax);
-  PacketHits h;
-  packet_hits_init(&h, tmax);
-  if (rtcl_any8(p.active)) kdtree_packet_traverse(&p, tmax, &h, header, nodes, refs, lanes, lane_prims, spheres);
-  packet_store(&h, hits, first, ray_count);
-}
+#define KD_PACKET_PARAMS                                                                              \
+  global const KdHeader *header, global const KdNode *nodes, global const int *refs, global const float *lanes, \
+      global const int *lane_prims, global const SphereBlock *spheres
+#define KD_PACKET_ARGS header, nodes, refs, lanes, lane_prims, spheres
+RTCL_PACKET_KERNELS(kdtree_packet, KD_PACKET_PARAMS, KD_PACKET_ARGS)

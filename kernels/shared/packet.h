@@ -270,4 +270,22 @@ inline void packet_store(const PacketHits* hp, global Hit* hits, uint first, uin
   }
 }
 
+/* The packet trace kernel of structure NAME: rays 8p .. 8p + 7 (those below
+ * ray_count) form the packet of work-item p; NAME##_traverse(&packet, &hits,
+ * ARGS) answers its active lanes (as RTCL_TRACE_KERNELS in shared/trace.h,
+ * for packets). */
+#define RTCL_PACKET_KERNELS(NAME, PARAMS, ARGS)                                                     \
+  kernel void RTCL_TRACE_KERNEL_NAME(NAME)(global const Ray* rays, global Hit* hits, uint ray_count, \
+                                           PARAMS) {                                                 \
+    uint first = get_global_id(0) * 8u;                                                             \
+    if (first >= ray_count) return;                                                                 \
+    TracePacket p;                                                                                  \
+    float8 tmax;                                                                                    \
+    packet_setup(rays, first, ray_count, &p, &tmax);                                                \
+    PacketHits h;                                                                                   \
+    packet_hits_init(&h, tmax);                                                                     \
+    if (rtcl_any8(p.active)) NAME##_traverse(&p, &h, ARGS);                                         \
+    packet_store(&h, hits, first, ray_count);                                                       \
+  }
+
 #endif
