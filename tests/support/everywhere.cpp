@@ -74,6 +74,8 @@ void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, cons
         expect_at_level(level, options.fast_must_pass, what, [&] {
           std::size_t disagreements = 0, failures = 0;
           std::string first, first_failure;
+          std::vector<Ray> unjudged_rays;
+          std::vector<Hit> unjudged_hits;
           for (std::size_t i = 0; i < rays.size(); ++i) {
             bool same = (hits[i].prim < 0) == (expected[i].prim < 0) &&
                         (query == Query::any || hits[i].prim < 0 || hits[i].t == expected[i].t);
@@ -82,9 +84,13 @@ void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, cons
                       ", brute force " + describe(expected[i]);
             bool judged_already = !accel || (hits[i].prim == expected[i].prim && hits[i].t == expected[i].t);
             if (options.judge && accel && !judged_already) {
-              std::string why = judge(geometry, rays[i], hits[i], query);
-              if (!why.empty() && failures++ == 0) first_failure = "ray " + describe(rays[i]) + ": " + why;
+              unjudged_rays.push_back(rays[i]);
+              unjudged_hits.push_back(hits[i]);
             }
+          }
+          if (!unjudged_rays.empty()) {
+            auto report = judge_all(geometry, unjudged_rays, unjudged_hits, query, &failures);
+            if (!report.empty()) first_failure = report[0];
           }
           // fast builds each kernel with -cl-fast-relaxed-math: no bit-for-bit promise between structures
           if (level != Precision::fast)
