@@ -14,8 +14,8 @@
 
 #include "bench_scenes.hpp"
 
-#ifdef RTCL_BENCH_HAVE_EMBREE
-#include "embree_baseline.hpp"
+#ifdef RTCL_HAVE_EMBREE
+#include "rtcl/bench/embree_baseline.hpp"
 #endif
 
 int main(int argc, char** argv) {
@@ -38,8 +38,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rtcl_bench: %s\n(the rtcl benchmarks will report this error)\n", e.what());
     benchmark::AddCustomContext("rtcl_device", "none");
   }
-#ifdef RTCL_BENCH_HAVE_EMBREE
-  benchmark::AddCustomContext("embree", embree_version());
+#ifdef RTCL_HAVE_EMBREE
+  benchmark::AddCustomContext("embree", embree_version(host_threads()));
 #else
   benchmark::AddCustomContext("embree", "not built (CMake did not find Embree 3)");
 #endif

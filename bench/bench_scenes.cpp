@@ -14,8 +14,8 @@
 #include "rtcl/render/ray_order.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 
-#ifdef RTCL_BENCH_HAVE_EMBREE
-#include "embree_baseline.hpp"
+#ifdef RTCL_HAVE_EMBREE
+#include "rtcl/bench/embree_baseline.hpp"
 #endif
 
 namespace rtcl::bench {
@@ -56,8 +56,8 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 class Oracle {
  public:
   explicit Oracle(const Geometry& geometry) : name_(oracle_name()) {
-#ifdef RTCL_BENCH_HAVE_EMBREE
-    embree_ = std::make_unique<EmbreeScene>(geometry, EmbreeQuality::standard);
+#ifdef RTCL_HAVE_EMBREE
+    embree_ = std::make_unique<EmbreeScene>(geometry, EmbreeQuality::standard, host_threads());
 #else
     accel_ = make_accel(bench_device(), name_, geometry);
 #endif
@@ -67,7 +67,7 @@ class Oracle {
 
   std::vector<Hit> trace(Query query, const std::vector<Ray>& rays) const {
     std::vector<Hit> hits(rays.size());
-#ifdef RTCL_BENCH_HAVE_EMBREE
+#ifdef RTCL_HAVE_EMBREE
     embree_->trace(query, rays.data(), hits.data(), rays.size(), host_threads());
 #else
     const Device& device = bench_device();
@@ -82,7 +82,7 @@ class Oracle {
 
  private:
   std::string name_;
-#ifdef RTCL_BENCH_HAVE_EMBREE
+#ifdef RTCL_HAVE_EMBREE
   std::unique_ptr<EmbreeScene> embree_;
 #else
   std::unique_ptr<Accel> accel_;
@@ -128,7 +128,7 @@ std::shared_ptr<const BenchScene> load_scene(const SceneSpec& spec) {
 }  // namespace
 
 std::string oracle_name() {
-#ifdef RTCL_BENCH_HAVE_EMBREE
+#ifdef RTCL_HAVE_EMBREE
   return "embree";
 #else
   auto names = accel_names();

@@ -1,6 +1,8 @@
 // Embree 3, the yardstick, over the same scenes and ray sets:
 //   build/<scene>/embree, build/<scene>/embree-high   rtcCommitScene wall time
 //   embree/<scene>/<kind>, embree/<scene>/<kind>/high  rtcIntersect1 / rtcOccluded1
+//   embree/<scene>/<kind>/packet                       rtcIntersect8 / rtcOccluded8 over the
+//                                                      8-ray groups rtcl's packet kernels take
 // Traversal runs on host_threads() threads (wall time of the whole set,
 // manual time, the traversal alone: Embree's ray records are built before
 // and the answers read after the timed region, as rtcl's kernel time leaves
@@ -13,7 +15,7 @@
 #include <string>
 
 #include "bench_scenes.hpp"
-#include "embree_baseline.hpp"
+#include "rtcl/bench/embree_baseline.hpp"
 
 namespace rtcl::bench {
 namespace {
@@ -27,7 +29,7 @@ const EmbreeScene& embree_scene(const std::shared_ptr<const BenchScene>& scene, 
     owner = scene;
   }
   auto& slot = built[quality == EmbreeQuality::high ? 1 : 0];
-  if (!slot) slot = std::make_unique<EmbreeScene>(scene->geometry, quality);
+  if (!slot) slot = std::make_unique<EmbreeScene>(scene->geometry, quality, host_threads());
   return *slot;
 }
 
@@ -35,7 +37,8 @@ double bytes_per_triangle(std::size_t bytes, std::size_t triangles) {
   return triangles ? static_cast<double>(bytes) / static_cast<double>(triangles) : 0.0;
 }
 
-void trace_benchmark(benchmark::State& state, const std::string& scene_name, RayKind kind, EmbreeQuality quality) {
+void trace_benchmark(benchmark::State& state, const std::string& scene_name, RayKind kind, EmbreeQuality quality,
+                     EmbreeApi api) {
   try {
     auto scene = bench_scene(scene_name);
     const EmbreeScene& embree = embree_scene(scene, quality);
@@ -44,10 +47,10 @@ void trace_benchmark(benchmark::State& state, const std::string& scene_name, Ray
     Query query = ray_kind_query(kind);
     unsigned threads = host_threads();
     std::vector<Hit> hits(count);
-    embree.trace(query, rays.rays.data(), hits.data(), count, threads);  // warm-up (page-in, TBB start)
+    embree.trace(query, rays.rays.data(), hits.data(), count, threads, api);  // warm-up (page-in, TBB start)
     double agree = agreement(hits, rays, query);
     for (auto _ : state) {
-      embree.prepare(query, rays.rays.data(), count);  // untimed: Embree's records built before the loop
+      embree.prepare(query, rays.rays.data(), count, api);  // untimed: Embree's records built before the loop
       auto start = std::chrono::steady_clock::now();
       embree.trace_prepared(threads);
       state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -61,7 +64,7 @@ void trace_benchmark(benchmark::State& state, const std::string& scene_name, Ray
     state.counters["bytes_per_tri"] = bytes_per_triangle(embree.bytes(), scene->triangle_count());
     state.counters["build_ms"] = embree.build_ms();
     state.counters["threads"] = threads;
-    state.SetLabel("Embree " + embree_version());
+    state.SetLabel("Embree " + embree_version(threads) + " " + embree_api_name(api, query));
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
   }
@@ -73,7 +76,7 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, Emb
     std::size_t bytes = 0;
     double total_ms = 0.0;
     for (auto _ : state) {
-      EmbreeScene embree(scene->geometry, quality);
+      EmbreeScene embree(scene->geometry, quality, host_threads());
       bytes = embree.bytes();
       total_ms += embree.build_ms();
       state.SetIterationTime(embree.build_ms() * 1e-3);
@@ -98,7 +101,15 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, Emb
     for (EmbreeQuality quality : {EmbreeQuality::standard, EmbreeQuality::high}) {
       std::string name = "embree/" + spec.name + "/" + ray_kind_name(kind);
       if (quality == EmbreeQuality::high) name += "/high";
-      benchmark::RegisterBenchmark(name.c_str(), trace_benchmark, spec.name, kind, quality)
+      benchmark::RegisterBenchmark(name.c_str(), trace_benchmark, spec.name, kind, quality, EmbreeApi::single)
+          ->UseManualTime()
+          ->Unit(benchmark::kMillisecond);
+    }
+  if (embree_has_packet8(host_threads()))
+    for (RayKind kind : ray_kinds) {
+      std::string name = "embree/" + spec.name + "/" + ray_kind_name(kind) + "/packet";
+      benchmark::RegisterBenchmark(name.c_str(), trace_benchmark, spec.name, kind, EmbreeQuality::standard,
+                                   EmbreeApi::packet8)
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond);
     }

@@ -21,7 +21,7 @@ std::string scenes_env() { return std::string("RTCL_SCENES_DIR=") + shell_quoted
 TEST(CliBench, SmokeRunWritesACompleteMatrix) {
   TempDir dir;
   CliRun run = run_cli(dir,
-                       {"bench", "--size", "32", "--scene", "bunny,tetra:levels=2", "--accel", "bvh,grid",
+                       {"bench", "--size", "32", "--scene", "bunny,tetra:levels=2", "--accel", "bvh,grid,bvh-packet",
                         "--repeat", "2", "--check-rays", "64", "--device", "0", "-o", dir.file("out")},
                        scenes_env());
   ASSERT_EQ(run.status, 0) << run.err;
@@ -32,6 +32,10 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
   ASSERT_EQ(json["devices"].size(), 1u);
   EXPECT_TRUE(json["devices"][0]["driver"].is_string());
   EXPECT_EQ(json["options"]["repeat"], 2);
+  // Embree's packet API is measured where Embree traces 8-ray packets natively.
+  bool embree_packets = false;
+  if (json["embree"].is_object())
+    for (const auto& b : json["embree"]["baselines"]) embree_packets = embree_packets || b["packets"].get<bool>();
   std::set<std::tuple<std::string, std::string, std::string>> seen;
   for (const auto& cell : json["cells"]) {
     seen.insert({cell["scene"].get<std::string>(), cell["accel"].get<std::string>(), cell["rays"].get<std::string>()});
@@ -44,11 +48,40 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
     EXPECT_EQ(cell["wall_ms_runs"].size(), 2u);
     EXPECT_TRUE(cell["check"]["ok"].is_boolean());
     EXPECT_GT(cell["check"]["rays"].get<int>(), 0) << cell.dump();
-    EXPECT_TRUE(cell.contains("embree"));
     EXPECT_EQ(cell["query"], cell["rays"] == "shadow" ? "any" : "closest");
+    ASSERT_TRUE(cell.contains("embree"));
+#ifdef RTCL_TESTS_EXPECT_EMBREE
+    // packets against packets: the packet kernel is compared with rtcIntersect8 / rtcOccluded8
+    bool packets = cell["accel"] == "bvh-packet";
+    EXPECT_EQ(cell["packets"], packets);
+    std::string api = cell["rays"] == "shadow" ? (packets ? "rtcOccluded8" : "rtcOccluded1")
+                                               : (packets ? "rtcIntersect8" : "rtcIntersect1");
+    if (packets && !embree_packets) {
+      EXPECT_TRUE(cell["embree"].is_null()) << cell.dump();
+      continue;
+    }
+    ASSERT_TRUE(cell["embree"].is_object()) << cell.dump();
+    EXPECT_EQ(cell["embree"]["api"], api);
+    EXPECT_GT(cell["embree"]["ratio"].get<double>(), 0.0) << cell.dump();
+    EXPECT_GT(cell["embree"]["mrays_per_s"]["median"].get<double>(), 0.0);
+#else
+    EXPECT_TRUE(cell["embree"].is_null());
+#endif
   }
+#ifdef RTCL_TESTS_EXPECT_EMBREE
+  ASSERT_TRUE(json["embree"].is_object());
+  EXPECT_TRUE(json["embree"]["version"].is_string());
+  for (const auto& b : json["embree"]["baselines"]) {
+    EXPECT_TRUE(b["check"]["ok"].get<bool>()) << b.dump();  // Embree agrees with brute force
+    EXPECT_EQ(b["trace_ms_runs"].size(), 2u);
+  }
+  // scenes x ray sets x {single, packet}
+  EXPECT_EQ(json["embree"]["baselines"].size(), 2u * 3u * (embree_packets ? 2u : 1u));
+#else
+  EXPECT_TRUE(json["embree"].is_null());
+#endif
   for (const char* scene : {"bunny", "tetra:levels=2"})
-    for (const char* accel : {"bvh", "grid"})
+    for (const char* accel : {"bvh", "grid", "bvh-packet"})
       for (const char* rays : {"primary", "shadow", "diffuse"})
         EXPECT_TRUE(seen.count({scene, accel, rays})) << scene << " " << accel << " " << rays;
   EXPECT_EQ(seen.size(), json["cells"].size());

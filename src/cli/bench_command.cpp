@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench_embree.hpp"
 #include "bench_report.hpp"
 #include "bench_scenes.hpp"
 #include "cli_errors.hpp"
@@ -41,6 +42,8 @@ struct BenchOptions {
   int size = 512;
   int repeat = 5;
   int check_rays = 256;
+  bool no_embree = false;
+  unsigned embree_threads = std::max(1u, std::thread::hardware_concurrency());
 };
 
 using Clock = std::chrono::steady_clock;
@@ -237,6 +240,7 @@ void run_bench(const BenchOptions& options) {
     run.devices.push_back({info.index, info.name, info.platform, info.type, info.version, driver});
   }
 
+  if (!options.no_embree) run.embree_version = embree_baseline_version(options.embree_threads);
   run.rtcl_version = RTCL_VERSION;
   run.rtcl_commit = RTCL_GIT_DESCRIBE;
   run.host_cpu = host_cpu();
@@ -250,6 +254,7 @@ void run_bench(const BenchOptions& options) {
   for (int k : kinds) run.ray_kinds.push_back(kind_names[k]);
 
   std::size_t total = scenes.size() * devices.size() * accels.size() * kinds.size(), done = 0;
+  if (!run.embree_version.empty()) total += scenes.size() * kinds.size();
   for (const BenchSceneSpec& scene_spec : scenes) {
     progress(done, total, scene_spec.text + ": loading, rays and brute-force references");
     LoadedBenchScene scene = load_bench_scene(scene_spec);
@@ -258,6 +263,26 @@ void run_bench(const BenchOptions& options) {
     run.scene_info.push_back({scene_spec.text, scene.geometry.triangles.size(), scene.geometry.spheres.size(),
                               scene.load_ms, ms_since(rays_start), rays.sets[0].size(), rays.sets[1].size(),
                               rays.sets[2].size()});
+    if (!run.embree_version.empty()) {
+      progress(done, total, scene_spec.text + " / Embree: build");
+      EmbreeBaseline embree(scene.geometry, options.embree_threads);
+      for (int k : kinds) {
+        progress(done, total, scene_spec.text + " / Embree / " + kind_names[k]);
+        for (bool packets : {false, true}) {
+          if (packets && !embree.has_packets()) continue;
+          BenchBaseline baseline;
+          baseline.scene = scene_spec.text;
+          baseline.rays = kind_names[k];
+          std::vector<Hit> hits = embree.measure(kind_query(k), packets, rays.sets[k], options.repeat, baseline);
+          if (!rays.sets[k].empty()) {
+            baseline.checked = rays.checked[k].size();
+            baseline.disagreeing = disagreeing(hits, rays, k);
+          }
+          run.embree.push_back(std::move(baseline));
+        }
+        ++done;
+      }
+    }
     for (std::size_t d = 0; d < devices.size(); ++d)
       for (const std::string& accel_name : accels) {
         progress(done, total, scene_spec.text + " / " + accel_name + " / " + run.devices[d].name + ": build");
@@ -278,6 +303,7 @@ void run_bench(const BenchOptions& options) {
           cell.setup_ms = std::max(0.0, setup - stats.build_ms);
           cell.device_bytes = stats.device_bytes;
           cell.primitives = stats.primitive_count;
+          cell.packets = accel->rays_per_work_item(Coherence::incoherent) > 1;
           measure(*accel, rays, k, options.repeat, cell);
           run.cells.push_back(std::move(cell));
           ++done;
@@ -318,6 +344,10 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--check-rays", options->check_rays,
                   "rays per set (every k-th) compared with brute force; 0: none")
       ->check(CLI::Range(0, 1 << 20))
+      ->capture_default_str();
+  cmd->add_flag("--no-embree", options->no_embree, "leave out the Embree baseline (present when rtcl was built with Embree)");
+  cmd->add_option("--embree-threads", options->embree_threads, "host threads Embree traces and builds on")
+      ->check(CLI::Range(1u, 1024u))
       ->capture_default_str();
   cmd->add_option("--scenes-dir", options->scenes_dir,
                   "directory of the shared meshes (default: $RTCL_SCENES_DIR, else /work/shared/scenes)");

@@ -28,7 +28,39 @@ Spread rate_of(std::size_t rays, const Spread& ms) {
   return {rate(ms.max), rate(ms.median), rate(ms.min)};
 }
 
-json cell_json(const BenchCell& c) {
+// The cell against its Embree baseline: Embree's traversal rate and the
+// ratio of the medians (rtcl kernel rate / Embree traversal rate).
+json embree_json(const BenchCell& c, const BenchBaseline* b) {
+  if (!b) return nullptr;
+  Spread embree = rate_of(b->ray_count, spread_of(b->trace_ms));
+  Spread rtcl = rate_of(c.ray_count, spread_of(c.kernel_ms));
+  return {{"api", b->api},
+          {"threads", b->threads},
+          {"mrays_per_s", spread_json(embree)},
+          {"ratio", embree.median > 0.0 ? rtcl.median / embree.median : 0.0}};
+}
+
+json baseline_json(const BenchBaseline& b) {
+  Spread trace = spread_of(b.trace_ms), wall = spread_of(b.wall_ms);
+  return {{"scene", b.scene},
+          {"rays", b.rays},
+          {"api", b.api},
+          {"packets", b.packets},
+          {"threads", b.threads},
+          {"ray_count", b.ray_count},
+          {"build_ms", b.build_ms},
+          {"bytes", b.bytes},
+          {"trace_ms", spread_json(trace)},
+          {"wall_ms", spread_json(wall)},
+          {"mrays_per_s", {{"trace", spread_json(rate_of(b.ray_count, trace))},
+                           {"wall", spread_json(rate_of(b.ray_count, wall))}}},
+          {"trace_ms_runs", b.trace_ms},
+          {"wall_ms_runs", b.wall_ms},
+          {"check", {{"reference", "brute"}, {"rays", b.checked}, {"disagreeing", b.disagreeing},
+                     {"ok", b.disagreeing == 0}}}};
+}
+
+json cell_json(const BenchCell& c, const BenchBaseline* baseline) {
   Spread kernel = spread_of(c.kernel_ms), wall = spread_of(c.wall_ms);
   return {
       {"device", c.device},
@@ -40,6 +72,7 @@ json cell_json(const BenchCell& c) {
       {"build_ms", c.build_ms},
       {"setup_ms", c.setup_ms},
       {"first_launch_ms", c.first_launch_ms},
+      {"packets", c.packets},
       {"device_bytes", c.device_bytes},
       {"primitives", c.primitives},
       {"bytes_per_primitive",
@@ -53,13 +86,18 @@ json cell_json(const BenchCell& c) {
       {"wall_ms_runs", c.wall_ms},
       {"check", {{"reference", "brute"}, {"rays", c.checked}, {"disagreeing", c.disagreeing},
                  {"ok", c.disagreeing == 0}}},
-      // Filled by a run with an Embree baseline: {"mrays_per_s": {...},
-      // "api": "rtcIntersect1" | ..., "threads": N, "ratio": rtcl / Embree}.
-      {"embree", nullptr},
+      // null without an Embree baseline
+      {"embree", embree_json(c, baseline)},
   };
 }
 
 }  // namespace
+
+const BenchBaseline* baseline_for(const BenchRun& run, const BenchCell& cell) {
+  for (const BenchBaseline& b : run.embree)
+    if (b.scene == cell.scene && b.rays == cell.rays && b.packets == cell.packets) return &b;
+  return nullptr;
+}
 
 std::string bench_json(const BenchRun& run) {
   json devices = json::array(), scenes = json::array(), cells = json::array();
@@ -70,7 +108,13 @@ std::string bench_json(const BenchRun& run) {
     scenes.push_back({{"name", s.name}, {"triangles", s.triangles}, {"spheres", s.spheres}, {"load_ms", s.load_ms},
                       {"rays_ms", s.rays_ms},
                       {"rays", {{"primary", s.primary}, {"shadow", s.shadow}, {"diffuse", s.diffuse}}}});
-  for (const BenchCell& c : run.cells) cells.push_back(cell_json(c));
+  for (const BenchCell& c : run.cells) cells.push_back(cell_json(c, baseline_for(run, c)));
+  json embree = nullptr;
+  if (!run.embree_version.empty()) {
+    json baselines = json::array();
+    for (const BenchBaseline& b : run.embree) baselines.push_back(baseline_json(b));
+    embree = {{"version", run.embree_version}, {"baselines", baselines}};
+  }
   json out = {
       {"schema", "rtcl-bench/1"},
       {"rtcl", {{"version", run.rtcl_version}, {"commit", run.rtcl_commit}}},
@@ -82,6 +126,7 @@ std::string bench_json(const BenchRun& run) {
       {"devices", devices},
       {"scenes", scenes},
       {"cells", cells},
+      {"embree", embree},
   };
   return out.dump(2) + "\n";
 }
@@ -108,7 +153,12 @@ std::string bench_markdown(const BenchRun& run) {
                    " threads), " + std::to_string(run.size) + "x" + std::to_string(run.size) +
                    " rays per primary set, median (min - max) Mrays/s of " + std::to_string(run.repeat) +
                    " kernel launches after a warm-up (OpenCL event times); build: host ms; B/prim: device bytes per "
-                   "primitive; check: rays agreeing with brute force.\n";
+                   "primitive; check: rays agreeing with brute force" +
+                   (run.embree_version.empty()
+                        ? std::string(".\n")
+                        : "; xE: ratio to Embree " + run.embree_version +
+                              " on the same rays (its traversal time on the host threads; packet kernels against "
+                              "rtcIntersect8 / rtcOccluded8).\n");
   for (std::size_t d = 0; d < run.devices.size(); ++d) {
     const BenchDevice& device = run.devices[d];
     md += "\n### [" + std::to_string(device.index) + "] " + device.name + " (" + device.platform + ", driver " +
@@ -130,7 +180,12 @@ std::string bench_markdown(const BenchRun& run) {
           }
           if (!first) first = c;
           Spread rate = rate_of(c->ray_count, spread_of(c->kernel_ms));
-          row += format(" %.2f (%.2f - %.2f) |", rate.median, rate.min, rate.max);
+          row += format(" %.2f (%.2f - %.2f)", rate.median, rate.min, rate.max);
+          if (const BenchBaseline* b = baseline_for(run, *c)) {
+            Spread embree = rate_of(b->ray_count, spread_of(b->trace_ms));
+            if (embree.median > 0.0) row += format(" x%.2fE", rate.median / embree.median);
+          }
+          row += " |";
           checked += c->checked;
           disagreeing += c->disagreeing;
         }
@@ -142,6 +197,46 @@ std::string bench_markdown(const BenchRun& run) {
                                             : 0.0;
         md += "| " + scene + " | " + accel + " |" + format(" %.1f |", first->build_ms) +
               format(" %.1f |", per_prim) + row + " " + check + " |\n";
+      }
+  }
+  if (!run.embree.empty()) {
+    md += "\n### Embree " + run.embree_version + " on the host (" + std::to_string(run.embree.front().threads) +
+          " threads)\n\n| scene | API | build ms | B/prim |";
+    for (const std::string& rays : run.ray_kinds) md += " " + rays + " |";
+    md += " check |\n|---|---|---:|---:|";
+    for (std::size_t i = 0; i < run.ray_kinds.size(); ++i) md += "---:|";
+    md += "---|\n";
+    for (const std::string& scene : run.scenes)
+      for (bool packets : {false, true}) {
+        std::string row, api;
+        const BenchBaseline* first = nullptr;
+        std::size_t checked = 0, disagreeing = 0;
+        for (const std::string& rays : run.ray_kinds) {
+          const BenchBaseline* b = nullptr;
+          for (const BenchBaseline& x : run.embree)
+            if (x.scene == scene && x.rays == rays && x.packets == packets) b = &x;
+          if (!b) {
+            row += " - |";
+            continue;
+          }
+          if (!first) first = b;
+          if (api.find(b->api) == std::string::npos) api += (api.empty() ? "" : " / ") + b->api;
+          Spread rate = rate_of(b->ray_count, spread_of(b->trace_ms));
+          row += format(" %.2f (%.2f - %.2f) |", rate.median, rate.min, rate.max);
+          checked += b->checked;
+          disagreeing += b->disagreeing;
+        }
+        if (!first) continue;
+        const BenchSceneInfo* info = nullptr;
+        for (const BenchSceneInfo& s : run.scene_info)
+          if (s.name == scene) info = &s;
+        std::size_t prims = info ? info->triangles : 0;
+        double per_prim = prims ? static_cast<double>(first->bytes) / static_cast<double>(prims) : 0.0;
+        std::string check = disagreeing == 0 ? "ok " + std::to_string(checked)
+                                             : "**DISAGREES " + std::to_string(disagreeing) + "/" +
+                                                   std::to_string(checked) + "**";
+        md += "| " + scene + " | " + api + " |" + format(" %.1f |", first->build_ms) + format(" %.1f |", per_prim) +
+              row + " " + check + " |\n";
       }
   }
   return md;

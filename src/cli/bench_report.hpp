@@ -32,6 +32,21 @@ struct BenchCell {
   std::vector<double> kernel_ms, wall_ms;  // per timed launch, in launch order
   bool profiled = false;                   // kernel_ms from OpenCL events (else the host clock)
   std::size_t checked = 0, disagreeing = 0;  // rays compared with brute force, and those that differ
+  // Whether the structure traces packets of eight consecutive rays (its
+  // compared with Embree's packet API, else with its single-ray API).
+  bool packets = false;
+};
+
+// Embree's figures for one scene and ray set (bench_embree.hpp).
+struct BenchBaseline {
+  std::string scene, rays, api;  // api: rtcIntersect1 | rtcOccluded1 | rtcIntersect8 | rtcOccluded8
+  bool packets = false;
+  unsigned threads = 0;
+  std::size_t ray_count = 0;
+  double build_ms = 0.0;   // rtcCommitScene and geometry setup, wall
+  std::size_t bytes = 0;   // Embree's memory after the build (its memory monitor)
+  std::vector<double> trace_ms, wall_ms;  // per timed trace: the traversal alone; with the ray and answer conversions
+  std::size_t checked = 0, disagreeing = 0;
 };
 
 struct BenchDevice {
@@ -59,7 +74,13 @@ struct BenchRun {
   std::vector<BenchDevice> devices;
   std::vector<BenchSceneInfo> scene_info;
   std::vector<BenchCell> cells;
+  std::string embree_version;  // "" when the run has no Embree baseline
+  std::vector<BenchBaseline> embree;
 };
+
+// The Embree baseline a cell is compared with (same scene and rays, packets
+// against packets), or null.
+const BenchBaseline* baseline_for(const BenchRun& run, const BenchCell& cell);
 
 std::string bench_json(const BenchRun& run);
 std::string bench_markdown(const BenchRun& run);

@@ -1,7 +1,9 @@
 // Embree 3 as the yardstick: the same triangles in one Embree scene, traced
-// one ray at a time (rtcIntersect1 / rtcOccluded1) by host threads over our
-// Ray records, answering into our Hit records. Built only when CMake finds
-// Embree 3 (RTCL_BENCH_HAVE_EMBREE).
+// by host threads over our Ray records, one ray at a time (rtcIntersect1 /
+// rtcOccluded1) or in packets of eight consecutive rays (rtcIntersect8 /
+// rtcOccluded8, the groups rtcl's packet kernels take), answering into our
+// Hit records. Built (library rtcl_embree, define RTCL_HAVE_EMBREE) only
+// when CMake finds Embree 3; `rtcl bench` and bench/ use it.
 #pragma once
 
 #include <cstddef>
@@ -19,11 +21,19 @@ enum class EmbreeQuality {
   high,      // RTC_BUILD_QUALITY_HIGH: SAH with spatial splits, slower build
 };
 
+enum class EmbreeApi {
+  single,   // rtcIntersect1 / rtcOccluded1, incoherent context (Embree's default)
+  packet8,  // rtcIntersect8 / rtcOccluded8 over rays 8k .. 8k + 7, coherent context
+};
+const char* embree_api_name(EmbreeApi api, Query query);  // e.g. "rtcIntersect8"
+
 class EmbreeScene {
  public:
   // Builds a scene (RTC_SCENE_FLAG_NONE) with one triangle mesh; primID is the
-  // triangle index. Throws Error with Embree's error code on failure.
-  EmbreeScene(const Geometry& geometry, EmbreeQuality quality);
+  // triangle index. `threads`: Embree's build threads (the first scene's
+  // count configures the process's one Embree device). Throws Error with
+  // Embree's error code on failure.
+  EmbreeScene(const Geometry& geometry, EmbreeQuality quality, unsigned threads);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -38,7 +48,8 @@ class EmbreeScene {
   // taking blocks of rays from a shared counter. Query::closest: t, u, v, prim
   // of the nearest hit (u, v as in Hit). Query::any: Embree reports no hit
   // data, so an occluded ray gets t = tmin, prim = 0, u = v = 0. Misses as Hit.
-  void trace(Query query, const Ray* rays, Hit* hits, std::size_t count, unsigned threads) const;
+  void trace(Query query, const Ray* rays, Hit* hits, std::size_t count, unsigned threads,
+             EmbreeApi api = EmbreeApi::single) const;
 
   // The same in three steps, so that only the traversal is timed, as
   // Embree's own framing has it (rays built before the loop, answers read
@@ -46,12 +57,12 @@ class EmbreeScene {
   // prepare() converts the rays into Embree's records, trace_prepared()
   // answers them in place on `threads` host threads, answers() converts
   // them into Hit records. prepare() again before each trace_prepared().
-  void prepare(Query query, const Ray* rays, std::size_t count) const;
+  void prepare(Query query, const Ray* rays, std::size_t count, EmbreeApi api = EmbreeApi::single) const;
   void trace_prepared(unsigned threads) const;
   void answers(Hit* hits) const;
 
  private:
-  void build(const Geometry& geometry, EmbreeQuality quality);
+  void build(const Geometry& geometry, EmbreeQuality quality, unsigned threads);
   void release();
   struct Buffers;
   struct Prepared;
@@ -62,7 +73,10 @@ class EmbreeScene {
   std::size_t bytes_ = 0;
 };
 
-// The library version, e.g. "3.13.5".
-std::string embree_version();
+// The library version, e.g. "3.13.5" (opens the Embree device with
+// `threads` if no scene did).
+std::string embree_version(unsigned threads);
+// Whether this Embree traces 8-wide packets natively (RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED).
+bool embree_has_packet8(unsigned threads);
 
 }  // namespace rtcl::bench

@@ -1,0 +1,79 @@
+#include "bench_embree.hpp"
+
+#include <chrono>
+
+#include "rtcl/error.hpp"
+
+#ifdef RTCL_HAVE_EMBREE
+#include "rtcl/bench/embree_baseline.hpp"
+#endif
+
+namespace rtcl::cli {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+}  // namespace
+
+#ifdef RTCL_HAVE_EMBREE
+
+struct EmbreeBaseline::Impl {
+  bench::EmbreeScene scene;
+};
+
+std::string embree_baseline_version(unsigned threads) { return bench::embree_version(threads); }
+
+EmbreeBaseline::EmbreeBaseline(const Geometry& geometry, unsigned threads)
+    : impl_(new Impl{bench::EmbreeScene(geometry, bench::EmbreeQuality::standard, threads)}), threads_(threads) {}
+
+bool EmbreeBaseline::has_packets() const { return bench::embree_has_packet8(threads_); }
+
+std::vector<Hit> EmbreeBaseline::measure(Query query, bool packets, const std::vector<Ray>& rays, int repeat,
+                                         BenchBaseline& out) const {
+  const bench::EmbreeScene& embree = impl_->scene;
+  const bench::EmbreeApi api = packets ? bench::EmbreeApi::packet8 : bench::EmbreeApi::single;
+  out.api = bench::embree_api_name(api, query);
+  out.packets = packets;
+  out.threads = threads_;
+  out.ray_count = rays.size();
+  out.build_ms = embree.build_ms();
+  out.bytes = embree.bytes();
+  std::vector<Hit> hits(rays.size());
+  if (rays.empty()) return hits;
+  embree.trace(query, rays.data(), hits.data(), rays.size(), threads_, api);  // warm-up: page-in, threads
+  for (int r = 0; r < repeat; ++r) {
+    Clock::time_point start = Clock::now();
+    embree.prepare(query, rays.data(), rays.size(), api);
+    Clock::time_point traced = Clock::now();
+    embree.trace_prepared(threads_);
+    Clock::time_point done = Clock::now();
+    embree.answers(hits.data());
+    out.trace_ms.push_back(ms_between(traced, done));
+    out.wall_ms.push_back(ms_between(start, Clock::now()));
+  }
+  return hits;
+}
+
+#else
+
+struct EmbreeBaseline::Impl {};
+
+std::string embree_baseline_version(unsigned) { return ""; }
+
+EmbreeBaseline::EmbreeBaseline(const Geometry&, unsigned threads) : threads_(threads) {
+  throw Error("rtcl was built without Embree: no Embree baseline");
+}
+
+bool EmbreeBaseline::has_packets() const { return false; }
+
+std::vector<Hit> EmbreeBaseline::measure(Query, bool, const std::vector<Ray>&, int, BenchBaseline&) const {
+  return {};
+}
+
+#endif
+
+EmbreeBaseline::~EmbreeBaseline() = default;
+
+}  // namespace rtcl::cli

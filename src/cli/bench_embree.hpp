@@ -1,0 +1,48 @@
+// The Embree baseline of `rtcl bench` (src/rtcl/bench/embree_baseline.hpp):
+// the very rays of a cell traced by Embree on host threads, timed as
+// Embree's own framing has it: the traversal alone (the rays converted into
+// Embree's records before it and the answers read after it, as rtcl's
+// kernel time leaves out upload and read-back), and the whole with those
+// conversions as the wall time. Absent, not an error, when rtcl was built
+// without Embree.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bench_report.hpp"
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/layouts.hpp"
+#include "rtcl/scene/geometry.hpp"
+
+namespace rtcl::cli {
+
+// "3.13.5", or "" when rtcl was built without Embree.
+std::string embree_baseline_version(unsigned threads);
+
+class EmbreeBaseline {
+ public:
+  // Builds Embree's scene of the geometry's triangles (its default, medium
+  // quality build on `threads` threads).
+  EmbreeBaseline(const Geometry& geometry, unsigned threads);
+  ~EmbreeBaseline();
+  EmbreeBaseline(const EmbreeBaseline&) = delete;
+  EmbreeBaseline& operator=(const EmbreeBaseline&) = delete;
+
+  // Whether Embree traces 8-ray packets natively here (rtcIntersect8 is then measured too).
+  bool has_packets() const;
+
+  // One warm-up trace, then `repeat` timed ones of `rays`, single rays or
+  // packets of rays 8k .. 8k + 7; fills the baseline's figures (not its
+  // check) and returns the answers of the last trace.
+  std::vector<Hit> measure(Query query, bool packets, const std::vector<Ray>& rays, int repeat,
+                           BenchBaseline& out) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  unsigned threads_;
+};
+
+}  // namespace rtcl::cli
