@@ -5,8 +5,13 @@
   PREFIX-mrays.png  Mrays/s (kernel time, median with min-max bars) per
                     structure per scene, one panel per ray set and device;
   PREFIX-build.png  host build time against primitive count, one line per
-                    structure (run e.g. --scene soup:count=1000,...,
-                    soup:count=4000000 to see how each build grows).
+                    structure and one for Embree's build when the run has
+                    its baseline (run e.g. --scene soup:count=1000,...,
+                    soup:count=4000000 to see how each build grows);
+  PREFIX-embree.png rtcl / Embree per structure per scene (the cell's
+                    "embree" ratio: single-ray kernels against rtcIntersect1
+                    / rtcOccluded1, packet kernels against rtcIntersect8 /
+                    rtcOccluded8), written when the run has the baseline.
 
     /usr/bin/python3 bench/plot_bench.py bench-results/bench.json [more.json ...] -o docs/bench
 
@@ -25,7 +30,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 
 def load(paths):
-    """Cells of every file, each with 'device_label' and 'triangles' added."""
+    """Cells of every file, each with 'device_label' and 'scene_primitives'
+    added, and Embree's builds as cells of structure 'embree'."""
     cells = []
     for path in paths:
         with open(path) as f:
@@ -41,10 +47,17 @@ def load(paths):
             cell["device_label"] = d["name"] if d["type"] != "cpu" else f"{d['platform']} on {cpu}"
             cell["scene_primitives"] = prims.get(cell["scene"], 0)
             cells.append(cell)
+        embree = data.get("embree") or {}
+        for b in embree.get("baselines", []):
+            if not b["packets"]:
+                cells.append({"device_label": f"host, {cpu}", "accel": f"Embree {embree['version']}",
+                              "scene": b["scene"], "rays": b["rays"], "build_ms": b["build_ms"],
+                              "scene_primitives": prims.get(b["scene"], 0), "baseline": True})
     return cells
 
 
 def plot_rates(cells, path):
+    cells = [c for c in cells if not c.get("baseline")]
     order = {"primary": 0, "shadow": 1, "diffuse": 2}
     panels = sorted({(c["device_label"], c["rays"]) for c in cells}, key=lambda p: (p[0], order.get(p[1], 3), p[1]))
     fig, axes = plt.subplots(len(panels), 1, figsize=(10, 3.2 * len(panels)), squeeze=False)
@@ -94,6 +107,37 @@ def plot_build(cells, path):
     print(f"written: {path}")
 
 
+def plot_embree(cells, path):
+    cells = [c for c in cells if not c.get("baseline") and c.get("embree")]
+    if not cells:
+        return
+    order = {"primary": 0, "shadow": 1, "diffuse": 2}
+    panels = sorted({(c["device_label"], c["rays"]) for c in cells}, key=lambda p: (p[0], order.get(p[1], 3), p[1]))
+    fig, axes = plt.subplots(len(panels), 1, figsize=(10, 3.2 * len(panels)), squeeze=False)
+    for ax, (device, rays) in zip(axes[:, 0], panels):
+        mine = [c for c in cells if c["device_label"] == device and c["rays"] == rays]
+        scenes = list(dict.fromkeys(c["scene"] for c in mine))
+        accels = list(dict.fromkeys(c["accel"] for c in mine))
+        width = 0.8 / max(1, len(accels))
+        for a, accel in enumerate(accels):
+            xs, ys = [], []
+            for s, scene in enumerate(scenes):
+                for c in mine:
+                    if c["scene"] == scene and c["accel"] == accel:
+                        xs.append(s + (a - (len(accels) - 1) / 2) * width)
+                        ys.append(c["embree"]["ratio"])
+            ax.bar(xs, ys, width, label=accel)
+        ax.axhline(1.0, color="black", linewidth=0.8)
+        ax.set_xticks(range(len(scenes)))
+        ax.set_xticklabels(scenes, fontsize=8)
+        ax.set_ylabel("rtcl / Embree")
+        ax.set_title(f"{rays} rays, {device}, against Embree on the host", fontsize=9)
+        ax.legend(fontsize=7, ncol=4)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    print(f"written: {path}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("json", nargs="+", help="bench.json files written by `rtcl bench`")
@@ -104,6 +148,7 @@ def main():
         raise SystemExit("no cells in " + ", ".join(args.json))
     plot_rates(cells, args.output + "-mrays.png")
     plot_build(cells, args.output + "-build.png")
+    plot_embree(cells, args.output + "-embree.png")
 
 
 if __name__ == "__main__":
