@@ -26,21 +26,18 @@
 #define RTCL_STACK_SIZE 64
 #endif
 
-/* Child c's box against the packet over [tmin, t_best]: intersect_boxes8's
- * arithmetic per lane (entry plane chosen by the lane's direction sign).
+/* Child c's box against the packet over [tmin, t_best]: rtcl_slabs8, the
+ * arithmetic of intersect_boxes8, per lane (entry plane chosen by the
+ * lane's direction sign).
  * Returns the entry distances, NaN where the ray misses the box. */
 inline float8 packet_box(global const Bvh8Node* node, int c, const TracePacket* p, float8 t_best, int8 mask) {
   float lx = node->bounds[0][c], ly = node->bounds[1][c], lz = node->bounds[2][c];
   float ux = node->bounds[3][c], uy = node->bounds[4][c], uz = node->bounds[5][c];
-  float8 tnx = (select((float8)(ux), (float8)(lx), p->pos_x) - p->ox) * p->ix;
-  float8 tny = (select((float8)(uy), (float8)(ly), p->pos_y) - p->oy) * p->iy;
-  float8 tnz = (select((float8)(uz), (float8)(lz), p->pos_z) - p->oz) * p->iz;
-  float8 tfx = (select((float8)(lx), (float8)(ux), p->pos_x) - p->ox) * p->ix;
-  float8 tfy = (select((float8)(ly), (float8)(uy), p->pos_y) - p->oy) * p->iy;
-  float8 tfz = (select((float8)(lz), (float8)(uz), p->pos_z) - p->oz) * p->iz;
-  float8 tn = rtcl_fmax8(tnx, rtcl_fmax8(tny, rtcl_fmax8(tnz, p->tmin)));
-  float8 tf = rtcl_fmin8(tfx, rtcl_fmin8(tfy, rtcl_fmin8(tfz, t_best)));
-  rtcl_widen_slab(&tn, &tf);
+  float8 tn, tf;
+  rtcl_slabs8(select((float8)(ux), (float8)(lx), p->pos_x), select((float8)(uy), (float8)(ly), p->pos_y),
+              select((float8)(uz), (float8)(lz), p->pos_z), select((float8)(lx), (float8)(ux), p->pos_x),
+              select((float8)(ly), (float8)(uy), p->pos_y), select((float8)(lz), (float8)(uz), p->pos_z), p->ox,
+              p->oy, p->oz, p->ix, p->iy, p->iz, p->tmin, t_best, &tn, &tf);
   return select((float8)(NAN), tn, mask & (tn <= tf));
 }
 

@@ -33,20 +33,32 @@ inline void rtcl_widen_slab(float8* tn, float8* tf) {
  * distances. Empty slots (lower = +inf, upper = -inf) never hit. Each axis's
  * distance enters a chain that starts from tmin or tmax, which are never
  * NaN, so tn and tf are not either. */
+/* The slab arithmetic, every argument per lane (a single-ray caller
+ * broadcasts its ray over eight boxes, a packet caller one box over its
+ * rays): the entry planes (nx, ny, nz) and exit planes (fx, fy, fz) chosen
+ * by the direction's signs, the widened entry and exit distances over
+ * [tmin, tmax] into *tn, *tf. The one source of every slab test's
+ * arithmetic, so single rays and packets get the same distances. */
+RTCL_LANES_INLINE void rtcl_slabs8(float8 nx, float8 ny, float8 nz, float8 fx, float8 fy, float8 fz, float8 ox,
+                                   float8 oy, float8 oz, float8 ix, float8 iy, float8 iz, float8 tmin, float8 tmax,
+                                   float8* tn, float8* tf) {
+  float8 tnx = (nx - ox) * ix;
+  float8 tny = (ny - oy) * iy;
+  float8 tnz = (nz - oz) * iz;
+  float8 tfx = (fx - ox) * ix;
+  float8 tfy = (fy - oy) * iy;
+  float8 tfz = (fz - oz) * iz;
+  *tn = rtcl_fmax8(tnx, rtcl_fmax8(tny, rtcl_fmax8(tnz, tmin)));
+  *tf = rtcl_fmin8(tfx, rtcl_fmin8(tfy, rtcl_fmin8(tfz, tmax)));
+  rtcl_widen_slab(tn, tf);
+}
+
 inline int8 intersect_box_rows8(global const float8* b, const TraceRay* s, float tmax, float8* t_entry,
                                 float8* t_exit) {
-  float8 tnx = (b[s->near_x] - s->ox) * s->ix;
-  float8 tny = (b[s->near_y] - s->oy) * s->iy;
-  float8 tnz = (b[s->near_z] - s->oz) * s->iz;
-  float8 tfx = (b[s->far_x] - s->ox) * s->ix;
-  float8 tfy = (b[s->far_y] - s->oy) * s->iy;
-  float8 tfz = (b[s->far_z] - s->oz) * s->iz;
-  float8 tn = rtcl_fmax8(tnx, rtcl_fmax8(tny, rtcl_fmax8(tnz, (float8)(s->tmin))));
-  float8 tf = rtcl_fmin8(tfx, rtcl_fmin8(tfy, rtcl_fmin8(tfz, (float8)(tmax))));
-  rtcl_widen_slab(&tn, &tf);
-  *t_entry = tn;
-  *t_exit = tf;
-  return tn <= tf;
+  rtcl_slabs8(b[s->near_x], b[s->near_y], b[s->near_z], b[s->far_x], b[s->far_y], b[s->far_z], (float8)(s->ox),
+              (float8)(s->oy), (float8)(s->oz), (float8)(s->ix), (float8)(s->iy), (float8)(s->iz),
+              (float8)(s->tmin), (float8)(tmax), t_entry, t_exit);
+  return *t_entry <= *t_exit;
 }
 
 /* Whether a slab test may rely on infinite slab distances for this ray:

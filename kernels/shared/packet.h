@@ -1,9 +1,12 @@
 /* Packets of 8 rays in float8 lanes, one lane per ray (Wald, Slusallek,
  * Benthin, Wagner 2001): the per-packet ray constants, the packet's hit
  * state and the per-lane primitive tests, shared by the packet kernels
- * (accel/bvh_packet.cl, accel/kdtree_packet.cl). Every lane gets exactly
- * the arithmetic of the single-ray tests (shared/triangle.h,
- * shared/sphere.h, trace_ray_setup), so closest-hit t is bit-identical to
+ * (accel/bvh_packet.cl, accel/kdtree_packet.cl). Every lane runs the
+ * single-ray tests' own lane-generic functions (rtcl_slabs8 of
+ * shared/box.h, rtcl_watertight_edges8 / rtcl_watertight_hit8 /
+ * rtcl_moller_trumbore8 of shared/triangle.h, rtcl_sphere_quadratic8 /
+ * rtcl_sphere_roots8 of shared/sphere.h) with the packet's rays in the
+ * lanes, and trace_ray_setup's setup, so closest-hit t is bit-identical to
  * them at every precision level. */
 #ifndef RTCL_SHARED_PACKET_H
 #define RTCL_SHARED_PACKET_H
@@ -156,16 +159,11 @@ inline int8 packet_triangle_at(global const float* at, int stride, int prim, con
   h->prim = select(h->prim, (int8)(prim), ok);
   return ok;
 #else
-  float8 az = v[0][2] - p->okz, bz = v[1][2] - p->okz, cz = v[2][2] - p->okz;
-  float8 ax = v[0][0] - p->okx - p->sx * az, ay = v[0][1] - p->oky - p->sy * az;
-  float8 bx = v[1][0] - p->okx - p->sx * bz, by = v[1][1] - p->oky - p->sy * bz;
-  float8 cx = v[2][0] - p->okx - p->sx * cz, cy = v[2][1] - p->oky - p->sy * cz;
-  float8 U = rtcl_edge8(cx, cy, bx, by);
-  float8 V = rtcl_edge8(ax, ay, cx, cy);
-  float8 W = rtcl_edge8(bx, by, ax, ay);
+  Watertight8 wt = rtcl_watertight_edges8(v[0][0], v[0][1], v[0][2], v[1][0], v[1][1], v[1][2], v[2][0], v[2][1],
+                                          v[2][2], p->okx, p->oky, p->okz, p->sx, p->sy);
 #ifdef RTCL_PRECISION_EXACT
-  int8 cand = mask & rtcl_exact_triangle_candidates(ax, ay, az, bx, by, bz, cx, cy, cz, U, V, W, p->sz, p->tmin,
-                                                    h->t_best);
+  int8 cand = mask & rtcl_exact_triangle_candidates(wt.Ax, wt.Ay, wt.Az, wt.Bx, wt.By, wt.Bz, wt.Cx, wt.Cy, wt.Cz,
+                                                    wt.U, wt.V, wt.W, p->sz, p->tmin, h->t_best);
   if (!rtcl_any8(cand)) return cand;
   int hit[8] = {0, 0, 0, 0, 0, 0, 0, 0};
   for (int l = 0; l < 8; ++l) {
@@ -180,16 +178,13 @@ inline int8 packet_triangle_at(global const float* at, int stride, int prim, con
   }
   return vload8(0, hit);
 #else
-  int8 inside = ((U >= 0.0f) & (V >= 0.0f) & (W >= 0.0f)) | ((U <= 0.0f) & (V <= 0.0f) & (W <= 0.0f));
-  float8 det = U + V + W;
-  float8 T = p->sz * (U * az + V * bz + W * cz);
-  float8 t = T / det;
-  int8 ok = mask & inside & (det != 0.0f) & (t >= p->tmin) & (t < h->t_best);
+  float8 t, det;
+  int8 ok = mask & rtcl_watertight_hit8(&wt, p->sz, p->tmin, h->t_best, &t, &det);
   if (!rtcl_any8(ok)) return ok;
   h->t_best = select(h->t_best, t, ok);
   h->det = select(h->det, det, ok);
-  h->V = select(h->V, V, ok);
-  h->W = select(h->W, W, ok);
+  h->V = select(h->V, wt.V, ok);
+  h->W = select(h->W, wt.W, ok);
   h->prim = select(h->prim, (int8)(prim), ok);
   return ok;
 #endif
@@ -197,21 +192,14 @@ inline int8 packet_triangle_at(global const float* at, int stride, int prim, con
 }
 
 #ifdef RTCL_HAS_SPHERES
-/* Sphere k of a block against the packet: intersect_sphere_lanes's
- * arithmetic per lane (Haines et al., Ray Tracing Gems ch. 7). */
+/* Sphere k of a block against the packet: rtcl_sphere_quadratic8 and its
+ * roots, intersect_sphere_lanes's arithmetic, per lane. */
 inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePacket* p, PacketHits* h, int8 mask) {
   float r = block->r[k];
-  float8 fx = p->ox - block->cx[k];
-  float8 fy = p->oy - block->cy[k];
-  float8 fz = p->oz - block->cz[k];
-  float8 a = p->dx * p->dx + p->dy * p->dy + p->dz * p->dz;
-  float8 b = -(fx * p->dx + fy * p->dy + fz * p->dz);
-  float8 kk = b / a;
-  float8 lx = fx + kk * p->dx, ly = fy + kk * p->dy, lz = fz + kk * p->dz;
-  float8 l2 = lx * lx + ly * ly + lz * lz;
-  float8 disc = a * (r * r - l2);
+  SphereQuadratic8 q = rtcl_sphere_quadratic8((float8)(block->cx[k]), (float8)(block->cy[k]), (float8)(block->cz[k]),
+                                              (float8)(r), p->ox, p->oy, p->oz, p->dx, p->dy, p->dz);
 #ifdef RTCL_PRECISION_EXACT
-  int8 cand = mask & (disc >= -(RTCL_EXACT_EDGE_ULPS * FLT_EPSILON) * a * (r * r + l2 + fx * fx + fy * fy + fz * fz));
+  int8 cand = mask & rtcl_sphere_candidates8(&q, (float8)(r));
   if (!rtcl_any8(cand)) return cand;
   int prim = block->prim[k];
   int hit[8] = {0, 0, 0, 0, 0, 0, 0, 0};
@@ -224,14 +212,10 @@ inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePac
     hit[l] = -packet_exact_record(h, l, t, prim, tmin, tmax, 0.0f, 0.0f);
   }
   return vload8(0, hit);
-#endif
-  int8 real = disc >= 0.0f;
-  float8 c = fx * fx + fy * fy + fz * fz - r * r;
-  float8 q = b + copysign(sqrt(fmax(disc, 0.0f)), b);
-  float8 t0 = c / q, t1 = q / a;
-  float8 tn = fmin(t0, t1), tf = fmax(t0, t1);
-  int8 ok_n = real & (tn >= p->tmin) & (tn < h->t_best);
-  int8 ok_f = real & (tf >= p->tmin) & (tf < h->t_best);
+#else
+  float8 tn, tf;
+  int8 ok_n, ok_f;
+  rtcl_sphere_roots8(&q, (float8)(r), p->tmin, h->t_best, &tn, &tf, &ok_n, &ok_f);
   float8 t = select(tf, tn, ok_n);
   int8 ok = mask & (ok_n | ok_f);
   if (!rtcl_any8(ok)) return ok;
@@ -241,6 +225,7 @@ inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePac
   h->W = select(h->W, (float8)(0.0f), ok);
   h->prim = select(h->prim, (int8)(block->prim[k]), ok);
   return ok;
+#endif
 }
 #endif
 

@@ -10,22 +10,62 @@
 
 #include "shared/exact.h"
 
+/* The ray/sphere quadratic, every argument per lane (a single-ray caller
+ * broadcasts its ray, a packet caller its sphere): f = o - c, a = d.d,
+ * b = -f.d (= a * t of the closest approach), the squared distance l2 of
+ * the line from the centre, and the discriminant a (r^2 - l2), which does
+ * not cancel for distant spheres (Haines et al., Ray Tracing Gems ch. 7).
+ * *cand (exact level): the lanes whose discriminant is real or within
+ * rounding of zero, which double precision then decides. The one source
+ * of this arithmetic. */
+typedef struct SphereQuadratic8 {
+  float8 fx, fy, fz, a, b, l2, disc;
+} SphereQuadratic8;
+
+RTCL_LANES_INLINE SphereQuadratic8 rtcl_sphere_quadratic8(float8 cx, float8 cy, float8 cz, float8 r, float8 ox,
+                                                          float8 oy, float8 oz, float8 dx, float8 dy, float8 dz) {
+  SphereQuadratic8 q;
+  q.fx = ox - cx;
+  q.fy = oy - cy;
+  q.fz = oz - cz;
+  q.a = dx * dx + dy * dy + dz * dz;
+  q.b = -(q.fx * dx + q.fy * dy + q.fz * dz);
+  float8 k = q.b / q.a;
+  float8 lx = q.fx + k * dx, ly = q.fy + k * dy, lz = q.fz + k * dz;
+  q.l2 = lx * lx + ly * ly + lz * lz;
+  q.disc = q.a * (r * r - q.l2);
+  return q;
+}
+
+#ifdef RTCL_PRECISION_EXACT
+RTCL_LANES_INLINE int8 rtcl_sphere_candidates8(const SphereQuadratic8* q, float8 r) {
+  return q->disc >= -(RTCL_EXACT_EDGE_ULPS * FLT_EPSILON) * q->a *
+                        (r * r + q->l2 + q->fx * q->fx + q->fy * q->fy + q->fz * q->fz);
+}
+#else
+/* The two roots (*tn <= *tf, from the numerically stable pair c / q, q / a)
+ * and which of them lie in [tmin, t_best). */
+RTCL_LANES_INLINE void rtcl_sphere_roots8(const SphereQuadratic8* q, float8 r, float8 tmin, float8 t_best,
+                                          float8* tn, float8* tf, int8* ok_n, int8* ok_f) {
+  int8 real = q->disc >= 0.0f;
+  float8 c = q->fx * q->fx + q->fy * q->fy + q->fz * q->fz - r * r;
+  float8 qq = q->b + copysign(sqrt(fmax(q->disc, 0.0f)), q->b);
+  float8 t0 = c / qq, t1 = qq / q->a;
+  *tn = fmin(t0, t1);
+  *tf = fmax(t0, t1);
+  *ok_n = real & (*tn >= tmin) & (*tn < t_best);
+  *ok_f = real & (*tf >= tmin) & (*tf < t_best);
+}
+#endif
+
 /* Lanes with radius NaN never hit. Records the nearest hit in
  * [tmin, h->t_best) (exact: by exact_better) in h and returns 1. */
 inline int intersect_sphere_lanes(float8 cx, float8 cy, float8 cz, float8 r, int8 prim, const TraceRay* s,
                                   HitState* h) {
-  float8 fx = s->ox - cx;
-  float8 fy = s->oy - cy;
-  float8 fz = s->oz - cz;
-  float a = s->dx * s->dx + s->dy * s->dy + s->dz * s->dz;
-  float8 b = -(fx * s->dx + fy * s->dy + fz * s->dz); /* = a * t_closest */
-  float8 k = b / a;
-  float8 lx = fx + k * s->dx, ly = fy + k * s->dy, lz = fz + k * s->dz;
-  float8 l2 = lx * lx + ly * ly + lz * lz;
-  float8 disc = a * (r * r - l2);
+  SphereQuadratic8 q = rtcl_sphere_quadratic8(cx, cy, cz, r, (float8)(s->ox), (float8)(s->oy), (float8)(s->oz),
+                                              (float8)(s->dx), (float8)(s->dy), (float8)(s->dz));
 #ifdef RTCL_PRECISION_EXACT
-  /* loose: the discriminant within rounding of zero, or real */
-  int8 cand = disc >= -(RTCL_EXACT_EDGE_ULPS * FLT_EPSILON) * a * (r * r + l2 + fx * fx + fy * fy + fz * fz);
+  int8 cand = rtcl_sphere_candidates8(&q, r);
   if (!rtcl_any8(cand)) return 0;
   float vc[4][8];
   int c[8], p[8];
@@ -47,13 +87,9 @@ inline int intersect_sphere_lanes(float8 cx, float8 cy, float8 cz, float8 r, int
   }
   return found;
 #else
-  int8 real = disc >= 0.0f;
-  float8 c = fx * fx + fy * fy + fz * fz - r * r;
-  float8 q = b + copysign(sqrt(fmax(disc, 0.0f)), b);
-  float8 t0 = c / q, t1 = q / a;
-  float8 tn = fmin(t0, t1), tf = fmax(t0, t1);
-  int8 ok_n = real & (tn >= s->tmin) & (tn < h->t_best);
-  int8 ok_f = real & (tf >= s->tmin) & (tf < h->t_best);
+  float8 tn, tf;
+  int8 ok_n, ok_f;
+  rtcl_sphere_roots8(&q, r, (float8)(s->tmin), (float8)(h->t_best), &tn, &tf, &ok_n, &ok_f);
   float8 t = select(select((float8)(INFINITY), tf, ok_f), tn, ok_n);
   int8 ok = ok_n | ok_f;
   if (!rtcl_any8(ok)) return 0;

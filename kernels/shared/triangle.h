@@ -50,6 +50,51 @@ inline int8 rtcl_moller_trumbore8(float8 ax, float8 ay, float8 az, float8 bx, fl
   return (det != 0.0f) & (*u >= 0.0f) & (*v >= 0.0f) & (*u + *v <= 1.0f) & (*t >= tmin) & (*t < t_best);
 }
 
+#ifndef RTCL_PRECISION_FAST
+/* The watertight test's shear (Woop et al. 2013), every argument per lane
+ * (a single-ray caller broadcasts its ray, a packet caller its triangle):
+ * the vertices given on the ray's permuted axes (ax = a[kx], ...) relative
+ * to the origin and sheared along the ray, (Ax, Ay, Az), ..., and the edge
+ * functions U, V, W. The one source of this arithmetic. (A struct of
+ * values, not arrays: PoCL keeps it in registers.) */
+typedef struct Watertight8 {
+  float8 Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz, U, V, W;
+} Watertight8;
+
+RTCL_LANES_INLINE Watertight8 rtcl_watertight_edges8(float8 ax, float8 ay, float8 az, float8 bx, float8 by,
+                                                     float8 bz, float8 cx, float8 cy, float8 cz, float8 okx,
+                                                     float8 oky, float8 okz, float8 sx, float8 sy) {
+  Watertight8 w;
+  w.Az = az - okz;
+  w.Bz = bz - okz;
+  w.Cz = cz - okz;
+  w.Ax = ax - okx - sx * w.Az;
+  w.Ay = ay - oky - sy * w.Az;
+  w.Bx = bx - okx - sx * w.Bz;
+  w.By = by - oky - sy * w.Bz;
+  w.Cx = cx - okx - sx * w.Cz;
+  w.Cy = cy - oky - sy * w.Cz;
+  w.U = rtcl_edge8(w.Cx, w.Cy, w.Bx, w.By);
+  w.V = rtcl_edge8(w.Ax, w.Ay, w.Cx, w.Cy);
+  w.W = rtcl_edge8(w.Bx, w.By, w.Ax, w.Ay);
+  return w;
+}
+
+/* The robust level's decision from rtcl_watertight_edges8: the lanes hit
+ * in [tmin, t_best) (inside all three edges, either winding; not in the
+ * triangle's plane), with the hit distance *t and the determinant *det
+ * (barycentrics V / det, W / det). */
+RTCL_LANES_INLINE int8 rtcl_watertight_hit8(const Watertight8* w, float8 sz, float8 tmin, float8 t_best,
+                                            float8* t, float8* det) {
+  int8 inside = ((w->U >= 0.0f) & (w->V >= 0.0f) & (w->W >= 0.0f)) |
+                ((w->U <= 0.0f) & (w->V <= 0.0f) & (w->W <= 0.0f));
+  *det = w->U + w->V + w->W;
+  float8 T = sz * (w->U * w->Az + w->V * w->Bz + w->W * w->Cz);
+  *t = T / *det;
+  return inside & (*det != 0.0f) & (*t >= tmin) & (*t < t_best);
+}
+#endif
+
 /* Eight triangles against the ray: lane l is the triangle with vertices
  * (a, b, c) given on the ray's permuted axes (kx, ky, kz): ax = a[kx], ...
  * Lanes with NaN vertices never hit. If one is hit in [tmin, h->t_best)
@@ -72,16 +117,11 @@ inline int intersect_triangle_lanes(float8 ax, float8 ay, float8 az, float8 bx, 
   h->prim = rtcl_lane_i(prim, lane);
   return 1;
 #else
-  float8 Az = az - s->okz, Bz = bz - s->okz, Cz = cz - s->okz;
-  float8 Ax = ax - s->okx - s->sx * Az, Ay = ay - s->oky - s->sy * Az;
-  float8 Bx = bx - s->okx - s->sx * Bz, By = by - s->oky - s->sy * Bz;
-  float8 Cx = cx - s->okx - s->sx * Cz, Cy = cy - s->oky - s->sy * Cz;
-  float8 U = rtcl_edge8(Cx, Cy, Bx, By);
-  float8 V = rtcl_edge8(Ax, Ay, Cx, Cy);
-  float8 W = rtcl_edge8(Bx, By, Ax, Ay);
+  Watertight8 w = rtcl_watertight_edges8(ax, ay, az, bx, by, bz, cx, cy, cz, (float8)(s->okx), (float8)(s->oky),
+                                         (float8)(s->okz), (float8)(s->sx), (float8)(s->sy));
 #ifdef RTCL_PRECISION_EXACT
-  int8 cand = rtcl_exact_triangle_candidates(Ax, Ay, Az, Bx, By, Bz, Cx, Cy, Cz, U, V, W, (float8)(s->sz),
-                                             (float8)(s->tmin), (float8)(h->t_best));
+  int8 cand = rtcl_exact_triangle_candidates(w.Ax, w.Ay, w.Az, w.Bx, w.By, w.Bz, w.Cx, w.Cy, w.Cz, w.U, w.V, w.W,
+                                             (float8)(s->sz), (float8)(s->tmin), (float8)(h->t_best));
   if (!rtcl_any8(cand)) return 0;
   float va[9][8];
   int c[8], p[8];
@@ -106,19 +146,16 @@ inline int intersect_triangle_lanes(float8 ax, float8 ay, float8 az, float8 bx, 
   }
   return found;
 #else
-  int8 inside = ((U >= 0.0f) & (V >= 0.0f) & (W >= 0.0f)) | ((U <= 0.0f) & (V <= 0.0f) & (W <= 0.0f));
-  float8 det = U + V + W;
-  float8 T = s->sz * (U * Az + V * Bz + W * Cz);
-  float8 t = T / det;
-  int8 ok = inside & (det != 0.0f) & (t >= s->tmin) & (t < h->t_best);
+  float8 t, det;
+  int8 ok = rtcl_watertight_hit8(&w, (float8)(s->sz), (float8)(s->tmin), (float8)(h->t_best), &t, &det);
   if (!rtcl_any8(ok)) return 0;
   float8 t_ok = select((float8)(INFINITY), t, ok);
   float m = rtcl_min8(t_ok);
   int lane = rtcl_lane_of(t_ok, m);
   float inv_det = 1.0f / rtcl_lane(det, lane);
   h->t_best = m;
-  h->u = rtcl_lane(V, lane) * inv_det;
-  h->v = rtcl_lane(W, lane) * inv_det;
+  h->u = rtcl_lane(w.V, lane) * inv_det;
+  h->v = rtcl_lane(w.W, lane) * inv_det;
   h->prim = rtcl_lane_i(prim, lane);
   return 1;
 #endif
