@@ -41,9 +41,9 @@ constexpr float kNaN = everywhere::kNaN;
 
 // True when the triangle contains the point where the ray meets its plane
 // (closed triangle, edges and vertices included, in double precision).
-bool on_triangle(const Geometry& g, int prim, const Ray& ray, double tolerance) {
+bool on_triangle(const Geometry& g, const Aabb& bounds, int prim, const Ray& ray, double tolerance) {
   if (prim < 0 || prim >= static_cast<int>(g.triangles.size())) return false;
-  PrimHit h = reference_intersect(g, static_cast<std::uint32_t>(prim), ray);
+  PrimHit h = reference_intersect(g, static_cast<std::uint32_t>(prim), ray, tolerance_in(bounds, ray));
   return h.plane && h.margin >= -tolerance;
 }
 
@@ -240,6 +240,7 @@ AxisRays cube_axis_rays() {
 
 TEST(Adversarial, AxisParallelRaysThroughCubeVerticesEdgesAndFacePlanes) {
   Geometry cube = cube_grid(8);
+  const Aabb cube_bounds = cube.bounds();
   AxisRays axis = cube_axis_rays();
   run_everywhere(cube, axis.rays, [&](const std::string&, Query query, const std::vector<Hit>& hits) {
     std::size_t wrong = 0;
@@ -248,7 +249,7 @@ TEST(Adversarial, AxisParallelRaysThroughCubeVerticesEdgesAndFacePlanes) {
       const Ray& r = axis.rays[i];
       // Edges and vertices are inside both triangles that share them, faces
       // parallel to the ray never count: the face ahead is hit exactly.
-      bool ok = hits[i].prim >= 0 && on_triangle(cube, hits[i].prim, r, 0.0);
+      bool ok = hits[i].prim >= 0 && on_triangle(cube, cube_bounds, hits[i].prim, r, 0.0);
       if (query == Query::closest) ok = ok && hits[i].t == axis.expected_t[i];
       if (!ok && wrong++ == 0)
         first = "ray " + describe(r) + " expected t=" + std::to_string(axis.expected_t[i]) + ", got " +
@@ -301,6 +302,7 @@ TEST(Adversarial, RaysInThePlaneOfAFaceHitOnlyTheEdgeAhead) {
   // the plane: the top face is parallel (never reported); the side face the
   // ray reaches is hit on its top edge.
   Geometry cube = cube_grid(8);
+  const Aabb cube_bounds = cube.bounds();
   std::vector<Ray> rays;
   std::mt19937 rng(5);
   std::uniform_real_distribution<float> across(-0.9f, 0.9f), slope(-0.2f, 0.2f);
@@ -318,7 +320,7 @@ TEST(Adversarial, RaysInThePlaneOfAFaceHitOnlyTheEdgeAhead) {
     std::string first;
     for (std::size_t i = 0; i < hits.size(); ++i) {
       const Ray& r = rays[i];
-      bool ok = hits[i].prim >= 0 && on_triangle(cube, hits[i].prim, r, 1e-6) &&
+      bool ok = hits[i].prim >= 0 && on_triangle(cube, cube_bounds, hits[i].prim, r, 1e-6) &&
                 cube.vertices[cube.triangles[hits[i].prim].x].x == -1.0f &&
                 cube.vertices[cube.triangles[hits[i].prim].y].x == -1.0f &&
                 std::abs(hits[i].t - 2.0f) <= 1e-6f;
@@ -485,6 +487,7 @@ TEST(Adversarial, OriginsOnASurface) {
   // Origins exactly on the cube's x = 1 face (vertices, edges, interiors),
   // directions into the cube.
   Geometry cube = cube_grid(8);
+  const Aabb cube_bounds = cube.bounds();
   std::vector<Ray> axis_rays, oblique, offset;
   std::mt19937 rng(4);
   std::uniform_real_distribution<float> unit(-0.9f, 0.9f);
@@ -502,7 +505,7 @@ TEST(Adversarial, OriginsOnASurface) {
   run_everywhere(cube, axis_rays, [&](const std::string&, Query query, const std::vector<Hit>& hits) {
     for (std::size_t i = 0; i < hits.size(); ++i) {
       ASSERT_GE(hits[i].prim, 0) << describe(axis_rays[i]);
-      EXPECT_TRUE(on_triangle(cube, hits[i].prim, axis_rays[i], 0.0)) << describe(axis_rays[i]);
+      EXPECT_TRUE(on_triangle(cube, cube_bounds, hits[i].prim, axis_rays[i], 0.0)) << describe(axis_rays[i]);
       if (query == Query::closest) EXPECT_EQ(hits[i].t, 0.0f) << describe(axis_rays[i]);
     }
   });

@@ -80,16 +80,17 @@ PrimHit reference_intersect(const Geometry& g, std::uint32_t prim, const Ray& ra
   return intersect(g, prim, ray, tolerance, false);
 }
 
-namespace {
-
-// The scene's bounds cost a pass over every primitive: the functions below
-// take them computed once.
 Tolerance tolerance_in(const Aabb& box, const Ray& ray, double ulps) {
   glm::dvec3 lo(box.lower), hi(box.upper), o = origin(ray);
   double magnitude = std::max({glm::length(hi - lo), glm::length(lo), glm::length(hi), glm::length(o)});
   double space = ulps * FLT_EPSILON * magnitude;
   return {space, space / glm::length(direction(ray))};
 }
+
+namespace {
+
+// The scene's bounds cost a pass over every primitive: the functions below
+// take them computed once.
 
 Hit closest_in(const Geometry& g, const Aabb& box, const Ray& ray) {
   Hit best{std::numeric_limits<float>::infinity(), 0.0f, 0.0f, -1};

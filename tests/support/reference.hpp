@@ -35,6 +35,9 @@ struct Tolerance {
 // Scales with the scene's extent and the ray origin's magnitude, in units of
 // float epsilon times `ulps`.
 Tolerance tolerance_for(const Geometry& geometry, const Ray& ray, double ulps = 256.0);
+// The same with the scene's bounds given (geometry.bounds(): a pass over
+// every primitive, computed once where many rays are checked).
+Tolerance tolerance_in(const Aabb& bounds, const Ray& ray, double ulps = 256.0);
 
 // Nearest clear hit (t = +inf, prim = -1 when none) by brute force in double.
 Hit reference_closest(const Geometry& geometry, const Ray& ray);
