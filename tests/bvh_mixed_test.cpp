@@ -261,6 +261,33 @@ TEST(BvhMixed, FarFromTheOriginStaysConservative) {
   expect_agrees(g, aimed_rays(g, 17), forced_specs());
 }
 
+// At every precision level the filters only drop children that hold no
+// hit, and bvh-mixed builds the tree of "bvh" and runs its kernel: with
+// every filter forced, the answers are those of "bvh" at that level, bit for
+// bit (same primitive, t, u, v), for both queries.
+TEST(BvhMixed, ForcedFiltersAnswerAsThePlainBvhAtEveryLevel) {
+  for (const Geometry& g : {random_soup(1500, 31), random_soup(800, 37, 0.05f, 1.0f, glm::vec3(-4.0e4f, 1.0e4f, 2.0e4f))}) {
+    std::vector<Ray> rays = aimed_rays(g, 41, 200);
+    for (Precision level : {Precision::fast, Precision::robust, Precision::exact}) {
+      auto plain = make_accel(test_device(), "bvh", g, {level});
+      auto mixed = make_accel(test_device(), forced_specs().back(), g, {level});
+      for (Query q : {Query::closest, Query::any}) {
+        std::vector<Hit> want = run_query(*plain, rays, q), got = run_query(*mixed, rays, q);
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+          bool same = got[i].prim == want[i].prim &&
+                      (q == Query::any || (got[i].t == want[i].t && got[i].u == want[i].u && got[i].v == want[i].v));
+          if (!same && differ++ < 3)
+            ADD_FAILURE() << precision_name(level) << (q == Query::closest ? " closest" : " any") << " on " << g.source
+                          << " ray " << i << ": prim " << got[i].prim << " t " << got[i].t << ", bvh prim "
+                          << want[i].prim << " t " << want[i].t;
+        }
+        EXPECT_EQ(differ, 0u) << precision_name(level) << " on " << g.source;
+      }
+    }
+  }
+}
+
 TEST(BvhMixed, WithoutFiltersItIsThePlainKernel) {
   Geometry g = random_soup(500, 19);
   const std::string spec = "bvh-mixed:sphere_cost=64,kdop_cost=64,obb_cost=64";

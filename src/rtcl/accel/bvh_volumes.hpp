@@ -36,12 +36,15 @@
 namespace rtcl {
 
 // Relative test costs, in units of one node's eight-box float8 slab test.
-// Defaults measured on PoCL (bench volume_cost/bunny/*: 65,536 of the
-// bunny's diffuse rays x 256 records, median of 3; README, "bvh-mixed").
+// Measured on PoCL (bench volume_cost/bunny/*: 65,536 of the bunny's
+// diffuse rays x 256 records, medians of three runs on the loaded 2-core
+// machine; README, "bvh-mixed"): sphere filter 0.7-1.4 (1.36 on a quieter
+// run), 14-DOP slabs 1.06-1.39, OBBs 1.5-2.0, triangle block 4.8-9.7 (8.1
+// on the quieter run). The defaults round those.
 struct VolumeCosts {
   float sphere = 1.3f;  // the eight-sphere filter of one node
   float kdop = 1.3f;    // the eight 14-DOP diagonal-slab filter
-  float obb = 2.5f;     // the eight-OBB filter
+  float obb = 2.0f;     // the eight-OBB filter
   float block = 8.0f;   // one leaf block (eight triangle tests in float8)
 };
 
