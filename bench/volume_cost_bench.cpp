@@ -1,6 +1,7 @@
 // Relative cost of the per-node tests the mixed-volume BVH chooses between
 // (VolumeCosts in src/rtcl/accel/bvh_volumes.hpp): one node's eight-box
-// slab test, its eight-sphere filter, and one eight-triangle leaf block, each
+// slab test, its eight-sphere, 14-DOP-diagonal and OBB filters, and one
+// eight-triangle leaf block, each
 // run by kernels/bench/volume_costs.cl over the bunny BVH's first records for
 // the bunny's diffuse rays. Counter ns_per_test: kernel time / (rays x records).
 #include <benchmark/benchmark.h>
@@ -32,6 +33,48 @@ std::vector<Bvh8Spheres> box_spheres(const std::vector<Bvh8Node>& nodes) {
   return out;
 }
 
+// k-DOP and OBB records for timing only: each lane's box's own diagonal
+// slabs, and an OBB about the box's centre turned by 0.5 rad about z
+// (the filters have no data-dependent branches).
+std::vector<Bvh8Kdop> box_kdops(const std::vector<Bvh8Node>& nodes) {
+  const float c = RTCL_KDOP_DIAGONAL;
+  const glm::vec3 dirs[RTCL_KDOP_FILTER_SLABS] = {{c, c, c}, {c, c, -c}, {c, -c, c}, {-c, c, c}};
+  std::vector<Bvh8Kdop> out(nodes.size());
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+      const auto& b = nodes[n].bounds;
+      bool empty = nodes[n].child[lane] == RTCL_CHILD_EMPTY;
+      glm::vec3 lo(b[0][lane], b[1][lane], b[2][lane]), hi(b[3][lane], b[4][lane], b[5][lane]);
+      glm::vec3 mid = empty ? glm::vec3(0.0f) : 0.5f * (lo + hi), half = empty ? glm::vec3(0.0f) : 0.5f * (hi - lo);
+      for (int j = 0; j < RTCL_KDOP_FILTER_SLABS; ++j) {
+        float centre = glm::dot(dirs[j], mid), extent = glm::dot(glm::abs(dirs[j]), half);
+        out[n].d_near[j][lane] = centre - extent;
+        out[n].d_far[j][lane] = centre + extent;
+      }
+    }
+  return out;
+}
+
+std::vector<Bvh8Obb> box_obbs(const std::vector<Bvh8Node>& nodes) {
+  const float cs = std::cos(0.5f), sn = std::sin(0.5f);
+  const glm::vec3 axes[3] = {{cs, sn, 0.0f}, {-sn, cs, 0.0f}, {0.0f, 0.0f, 1.0f}};
+  std::vector<Bvh8Obb> out(nodes.size());
+  for (std::size_t n = 0; n < nodes.size(); ++n)
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+      const auto& b = nodes[n].bounds;
+      bool empty = nodes[n].child[lane] == RTCL_CHILD_EMPTY;
+      glm::vec3 lo(b[0][lane], b[1][lane], b[2][lane]), hi(b[3][lane], b[4][lane], b[5][lane]);
+      glm::vec3 mid = empty ? glm::vec3(0.0f) : 0.5f * (lo + hi), half = empty ? glm::vec3(0.0f) : 0.5f * (hi - lo);
+      for (int i = 0; i < 3; ++i) {
+        for (int k = 0; k < 3; ++k) out[n].axis[3 * i + k][lane] = axes[i][k];
+        float centre = glm::dot(axes[i], mid), extent = glm::dot(glm::abs(axes[i]), half);
+        out[n].d_near[i][lane] = centre - extent;
+        out[n].d_far[i][lane] = centre + extent;
+      }
+    }
+  return out;
+}
+
 void volume_cost(benchmark::State& state, const char* kernel_name) {
   try {
     auto scene = bench_scene("bunny");
@@ -48,6 +91,10 @@ void volume_cost(benchmark::State& state, const char* kernel_name) {
       records = device.upload(bvh.nodes.data(), count * sizeof(Bvh8Node), "nodes");
     else if (kernel == "cost_spheres8")
       records = device.upload(spheres.data(), count * sizeof(Bvh8Spheres), "spheres");
+    else if (kernel == "cost_kdop8")
+      records = device.upload(box_kdops(bvh.nodes).data(), count * sizeof(Bvh8Kdop), "k-DOPs");
+    else if (kernel == "cost_obb8")
+      records = device.upload(box_obbs(bvh.nodes).data(), count * sizeof(Bvh8Obb), "OBBs");
     else
       records = device.upload(bvh.blocks.triangles.data(), count * sizeof(TriangleBlock), "blocks");
     cl::Buffer out = device.allocate(rays.size() * sizeof(cl_int), "counts");
@@ -72,7 +119,7 @@ void volume_cost(benchmark::State& state, const char* kernel_name) {
 }
 
 [[maybe_unused]] const bool registered = [] {
-  for (const char* kernel : {"cost_boxes8", "cost_spheres8", "cost_triangles8"})
+  for (const char* kernel : {"cost_boxes8", "cost_spheres8", "cost_kdop8", "cost_obb8", "cost_triangles8"})
     benchmark::RegisterBenchmark((std::string("volume_cost/bunny/") + kernel).c_str(), volume_cost, kernel)
         ->UseManualTime()
         ->Unit(benchmark::kMillisecond);

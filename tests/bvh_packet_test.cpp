@@ -94,7 +94,7 @@ TEST(BvhPacket, IsRegistered) {
 }
 
 // Which kernel a call gets: packets for coherent calls where the structure
-// has a packet kernel (every BVH but "bvh-mixed", whose sphere filter the
+// has a packet kernel (every BVH but "bvh-mixed", whose volume filters the
 // packet kernel lacks, and the kd-tree), for every call on "bvh-packet" and
 // "kdtree-packet", else one ray.
 TEST(BvhPacket, CoherenceSelectsTheKernel) {

@@ -22,19 +22,50 @@
  * traversal stays a separate function (its private arrays stay on the
  * native stack instead of becoming per-work-item arrays).
  *
- * Mixed volumes (RTCL_BVH_SPHERES, the "bvh-mixed" structure): nodes with
- * sphere_of[node] >= 0 also filter the children their boxes let through by
- * the bounding spheres of record sphere_of[node] (shared/sphere_filter8.h).
- * Without the define the kernel has no sphere code and no extra arguments. */
+ * Mixed volumes (the "bvh-mixed" structure): a node with filter_of[node]
+ * >= 0 (RTCL_FILTER_REF of shared/layouts.h) also filters the children its
+ * boxes let through by the record of one kind: bounding spheres
+ * (RTCL_BVH_SPHERES, shared/sphere_filter8.h), body-diagonal k-DOP slabs
+ * (RTCL_BVH_KDOP, shared/kdop_filter8.h) or oriented boxes (RTCL_BVH_OBB,
+ * shared/obb_filter8.h). Each define is passed only when some node uses
+ * that kind; each kind's record array is an argument only then, and
+ * without any of them the kernel has no filter code and no extra
+ * arguments. */
 #include "shared/trace.h"
+#if defined(RTCL_BVH_SPHERES) || defined(RTCL_BVH_KDOP) || defined(RTCL_BVH_OBB)
+#define RTCL_BVH_FILTERS
+#define BVH_FILTER_OF_PARAM , global const int *filter_of
+#define BVH_FILTER_OF_ARG , filter_of
+#else
+#define BVH_FILTER_OF_PARAM
+#define BVH_FILTER_OF_ARG
+#endif
 #ifdef RTCL_BVH_SPHERES
 #include "shared/sphere_filter8.h"
-#define BVH_SPHERE_PARAMS , global const int *sphere_of, global const Bvh8Spheres *sphere_filters
-#define BVH_SPHERE_ARGS , sphere_of, sphere_filters
+#define BVH_SPHERE_PARAM , global const Bvh8Spheres *sphere_filters
+#define BVH_SPHERE_ARG , sphere_filters
 #else
-#define BVH_SPHERE_PARAMS
-#define BVH_SPHERE_ARGS
+#define BVH_SPHERE_PARAM
+#define BVH_SPHERE_ARG
 #endif
+#ifdef RTCL_BVH_KDOP
+#include "shared/kdop_filter8.h"
+#define BVH_KDOP_PARAM , global const Bvh8Kdop *kdop_filters
+#define BVH_KDOP_ARG , kdop_filters
+#else
+#define BVH_KDOP_PARAM
+#define BVH_KDOP_ARG
+#endif
+#ifdef RTCL_BVH_OBB
+#include "shared/obb_filter8.h"
+#define BVH_OBB_PARAM , global const Bvh8Obb *obb_filters
+#define BVH_OBB_ARG , obb_filters
+#else
+#define BVH_OBB_PARAM
+#define BVH_OBB_ARG
+#endif
+#define BVH_FILTER_PARAMS BVH_FILTER_OF_PARAM BVH_SPHERE_PARAM BVH_KDOP_PARAM BVH_OBB_PARAM
+#define BVH_FILTER_ARGS BVH_FILTER_OF_ARG BVH_SPHERE_ARG BVH_KDOP_ARG BVH_OBB_ARG
 
 #ifndef RTCL_STACK_SIZE
 #define RTCL_STACK_SIZE 64
@@ -42,10 +73,17 @@
 
 __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
                                             global const TriangleBlock* triangles,
-                                            global const SphereBlock* spheres BVH_SPHERE_PARAMS) {
+                                            global const SphereBlock* spheres BVH_FILTER_PARAMS) {
 #ifdef RTCL_BVH_SPHERES
-  SphereFilterRay filter;
-  sphere_filter_setup(s, &filter);
+  SphereFilterRay sphere_ray;
+  sphere_filter_setup(s, &sphere_ray);
+#endif
+#ifdef RTCL_BVH_KDOP
+  KdopFilterRay kdop_ray;
+  kdop_filter_setup(s, &kdop_ray);
+#endif
+#ifdef RTCL_BVH_OBB
+  float obb_widen = obb_filter_setup(s);
 #endif
   int stack_ref[RTCL_STACK_SIZE];
   float stack_t[RTCL_STACK_SIZE]; /* entry distance of stack_ref's box */
@@ -55,10 +93,24 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
     if (ref >= 0) {
       global const Bvh8Node* node = nodes + ref;
       float8 t_entry;
-      int8 hit = intersect_boxes8(node, s, h->t_best, &t_entry);
+#ifdef RTCL_BVH_FILTERS
+      float8 t_exit;
+      int8 hit = intersect_box_rows8((global const float8*)node->bounds, s, h->t_best, &t_entry, &t_exit);
+      int filter = filter_of[ref];
+      if (filter >= 0 && rtcl_any8(hit)) {
+        int kind = RTCL_FILTER_KIND(filter), index = RTCL_FILTER_INDEX(filter);
 #ifdef RTCL_BVH_SPHERES
-      int filter_ref = sphere_of[ref];
-      if (filter_ref >= 0 && rtcl_any8(hit)) hit &= sphere_filter8(sphere_filters + filter_ref, s, &filter);
+        if (kind == RTCL_FILTER_SPHERE) hit &= sphere_filter8(sphere_filters + index, s, &sphere_ray);
+#endif
+#ifdef RTCL_BVH_KDOP
+        if (kind == RTCL_FILTER_KDOP) hit &= kdop_filter8(kdop_filters + index, &kdop_ray, t_entry, t_exit);
+#endif
+#ifdef RTCL_BVH_OBB
+        if (kind == RTCL_FILTER_OBB) hit &= obb_filter8(obb_filters + index, s, obb_widen, t_entry, t_exit);
+#endif
+      }
+#else
+      int8 hit = intersect_boxes8(node, s, h->t_best, &t_entry);
 #endif
       if (rtcl_any8(hit)) {
         int base = sp;
@@ -98,6 +150,6 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
 
 #define BVH_PARAMS                                                                                    \
   global const Bvh8Node *nodes, global const TriangleBlock *triangles, global const SphereBlock *spheres \
-      BVH_SPHERE_PARAMS
-#define BVH_ARGS nodes, triangles, spheres BVH_SPHERE_ARGS
+      BVH_FILTER_PARAMS
+#define BVH_ARGS nodes, triangles, spheres BVH_FILTER_ARGS
 RTCL_TRACE_KERNELS(bvh, BVH_PARAMS, BVH_ARGS)

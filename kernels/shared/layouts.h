@@ -72,6 +72,49 @@ typedef struct Bvh8Spheres {
   float r[RTCL_BLOCK_WIDTH];
 } Bvh8Spheres;
 
+/* k-DOP filters of the eight children of one node of the mixed-volume BVH
+ * (kernels/shared/kdop_filter8.h): with the node's boxes (the three axis
+ * slabs) they form each child's 14-DOP, the 7-direction set of
+ * src/rtcl/bounds/kdop.hpp. Row j (0..3) is slab j, d_near[j][lane] <=
+ * dot(n_j, x) <= d_far[j][lane], for the body diagonals
+ * n_j = RTCL_KDOP_DIAGONAL * (1, 1, 1), (1, 1, -1), (1, -1, 1), (-1, 1, 1)
+ * (the float unit vectors of kdop.cpp, in that order); d_near and d_far are
+ * already widened outward by the ray-independent part of the rounding
+ * margin. A lane without a filter has d_near = -FLT_MAX, d_far = FLT_MAX.
+ * 256 bytes: every record starts on a float8 boundary. */
+#define RTCL_KDOP_FILTER_SLABS 4
+#define RTCL_KDOP_DIAGONAL 0.577350269189625764509148780502f
+typedef struct Bvh8Kdop {
+  float d_near[RTCL_KDOP_FILTER_SLABS][RTCL_BLOCK_WIDTH];
+  float d_far[RTCL_KDOP_FILTER_SLABS][RTCL_BLOCK_WIDTH];
+} Bvh8Kdop;
+
+/* Oriented-box filters of the eight children of one node of the
+ * mixed-volume BVH (kernels/shared/obb_filter8.h): child lane's OBB is
+ * d_near[i][lane] <= dot(u_i, x) <= d_far[i][lane], i = 0..2, with the unit
+ * axis u_i = (axis[3i][lane], axis[3i + 1][lane], axis[3i + 2][lane]) (float
+ * values, orthonormal to ~1e-7; the stored slabs contain the child's
+ * contents exactly for these float axes) and d_near, d_far widened outward
+ * by the ray-independent part of the rounding margin. A lane without a
+ * filter has the world axes and d_near = -FLT_MAX, d_far = FLT_MAX.
+ * 480 bytes (15 float8 rows). */
+typedef struct Bvh8Obb {
+  float axis[9][RTCL_BLOCK_WIDTH];
+  float d_near[3][RTCL_BLOCK_WIDTH];
+  float d_far[3][RTCL_BLOCK_WIDTH];
+} Bvh8Obb;
+
+/* A node's filter in the mixed-volume BVH (filter_of[node] in
+ * kernels/accel/bvh.cl): -1 for none, else (record index << 2) | kind, the
+ * record indexing the array of that kind. */
+#define RTCL_FILTER_NONE (-1)
+#define RTCL_FILTER_SPHERE 0
+#define RTCL_FILTER_KDOP 1
+#define RTCL_FILTER_OBB 2
+#define RTCL_FILTER_REF(kind, index) ((rtcl_i32)(((index) << 2) | (kind)))
+#define RTCL_FILTER_KIND(ref) ((ref) & 3)
+#define RTCL_FILTER_INDEX(ref) ((ref) >> 2)
+
 /* Child references: >= 0 is an inner node index; RTCL_CHILD_EMPTY is an empty
  * slot; any other negative c is a leaf with ref = ~c (>= 0): ref >> 1 indexes
  * a TriangleBlock when (ref & 1) == 0, else a SphereBlock. */

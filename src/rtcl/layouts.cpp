@@ -16,6 +16,11 @@ static_assert(sizeof(SphereBlock) == 160 && offsetof(SphereBlock, r) == 96 && of
 static_assert(sizeof(Bvh8Node) == 224 && offsetof(Bvh8Node, child) == 192);
 static_assert(sizeof(Bvh8Node) % 32 == 0, "nodes must start on float8 boundaries");
 static_assert(sizeof(Bvh8Spheres) == 128 && offsetof(Bvh8Spheres, cz) == 64 && offsetof(Bvh8Spheres, r) == 96);
+static_assert(sizeof(Bvh8Kdop) == 256 && offsetof(Bvh8Kdop, d_far) == 128);
+static_assert(sizeof(Bvh8Obb) == 480 && offsetof(Bvh8Obb, d_near) == 288 && offsetof(Bvh8Obb, d_far) == 384);
+static_assert(sizeof(Bvh8Kdop) % 32 == 0 && sizeof(Bvh8Obb) % 32 == 0, "filter records hold float8 rows");
+static_assert(RTCL_FILTER_KIND(RTCL_FILTER_REF(RTCL_FILTER_OBB, 5)) == RTCL_FILTER_OBB &&
+              RTCL_FILTER_INDEX(RTCL_FILTER_REF(RTCL_FILTER_OBB, 5)) == 5);
 static_assert(sizeof(GridHeader) == 272 && offsetof(GridHeader, occupied_bounds) == 0 &&
               offsetof(GridHeader, lower) == 192 && offsetof(GridHeader, cell) == 208 &&
               offsetof(GridHeader, res) == 224 && offsetof(GridHeader, macro) == 240 &&

@@ -12,45 +12,59 @@ namespace {
 class MixedBvhAccel final : public Accel {
  public:
   MixedBvhAccel(const Device& device, std::vector<std::string> defines, const Bvh8& bvh,
-                const BvhSphereFilters& filters, AccelStats stats, const AccelConfig& config)
+                const BvhVolumeFilters& filters, AccelStats stats, const AccelConfig& config)
       : Accel(device, "bvh-mixed", TraceKernels{"accel/bvh.cl"}, std::nullopt, std::move(defines), stats, config),
         nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
-        primitives_(upload(device, bvh.blocks)),
-        filtered_(!filters.records.empty()) {
-    if (!filtered_) return;
-    sphere_of_ = device.upload(filters.sphere_of.data(), filters.sphere_of.size() * sizeof(rtcl_i32), "BVH sphere indices");
-    records_ = device.upload(filters.records.data(), filters.records.size() * sizeof(Bvh8Spheres), "BVH spheres");
+        primitives_(upload(device, bvh.blocks)) {
+    if (filters.empty()) return;
+    filter_of_ = device.upload(filters.filter_of.data(), filters.filter_of.size() * sizeof(rtcl_i32), "BVH filter indices");
+    if (!filters.spheres.empty())
+      records_.push_back(device.upload(filters.spheres.data(), filters.spheres.size() * sizeof(Bvh8Spheres), "BVH spheres"));
+    if (!filters.kdops.empty())
+      records_.push_back(device.upload(filters.kdops.data(), filters.kdops.size() * sizeof(Bvh8Kdop), "BVH k-DOPs"));
+    if (!filters.obbs.empty())
+      records_.push_back(device.upload(filters.obbs.data(), filters.obbs.size() * sizeof(Bvh8Obb), "BVH OBBs"));
   }
 
  private:
+  // Arguments after the primitives: filter_of, then the record array of
+  // each kind present, in RTCL_FILTER_* order (kernels/accel/bvh.cl).
   void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
     kernel.setArg(first, nodes_);
     kernel.setArg(first + 1, primitives_.triangles);
     kernel.setArg(first + 2, primitives_.spheres);
-    if (!filtered_) return;
-    kernel.setArg(first + 3, sphere_of_);
-    kernel.setArg(first + 4, records_);
+    if (records_.empty()) return;
+    kernel.setArg(first + 3, filter_of_);
+    for (std::size_t i = 0; i < records_.size(); ++i) kernel.setArg(first + 4 + static_cast<cl_uint>(i), records_[i]);
   }
 
   cl::Buffer nodes_;
   DevicePrimitives primitives_;
-  bool filtered_;
-  cl::Buffer sphere_of_, records_;
+  cl::Buffer filter_of_;
+  std::vector<cl::Buffer> records_;
 };
 
 }  // namespace
 
 const StructureSpec& bvh_mixed_structure() {
   static const StructureSpec spec = [] {
-    StructureSpec s{"bvh-mixed", "the bvh with a per-node choice of boxes alone or boxes then bounding spheres "
-                                 "(expected cost, surface-area based); one ray per work-item",
+    StructureSpec s{"bvh-mixed", "the bvh with a per-node choice of boxes alone or boxes then bounding spheres, "
+                                 "14-DOP slabs or oriented boxes (expected cost, surface-area based); one ray per "
+                                 "work-item",
                     bvh_sah_options()};
-    s.options.push_back({"sphere_cost", OptionType::real, double{VolumeCosts{}.sphere}, 0, 64, false,
+    const VolumeCosts d;
+    s.options.push_back({"sphere_cost", OptionType::real, double{d.sphere}, 0, 64, false,
                          "cost of a node's eight-sphere filter relative to its eight-box test (measured on PoCL: "
-                         "1.36); 0 puts spheres wherever they are smaller than the box, large values none"});
-    s.options.push_back({"block_cost", OptionType::real, double{VolumeCosts{}.block}, 0, 64, false,
+                         "0.7-1.4); 0 puts spheres wherever they are smaller than the box, large values none"});
+    s.options.push_back({"kdop_cost", OptionType::real, double{d.kdop}, 0, 64, false,
+                         "cost of a node's eight 14-DOP diagonal-slab filter relative to its eight-box test "
+                         "(measured on PoCL: 1.1-1.4); 0 puts it wherever it cuts the box, large values nowhere"});
+    s.options.push_back({"obb_cost", OptionType::real, double{d.obb}, 0, 64, false,
+                         "cost of a node's eight-OBB filter relative to its eight-box test (measured on PoCL: "
+                         "1.5-2.0); 0 puts it wherever it cuts the box, large values nowhere"});
+    s.options.push_back({"block_cost", OptionType::real, double{d.block}, 0, 64, false,
                          "cost of one leaf block (eight triangle tests) relative to a node's box test (measured "
-                         "on PoCL: 8.1)"});
+                         "on PoCL: 4.8-9.7)"});
     return s;
   }();
   return spec;
@@ -62,16 +76,18 @@ std::unique_ptr<Accel> make_bvh_mixed(const Device& device, const Geometry& geom
   AccelOptions o = resolve_options(bvh_mixed_structure(), config.options, "--accel bvh-mixed");
   VolumeCosts costs;
   costs.sphere = static_cast<float>(o.real("sphere_cost"));
+  costs.kdop = static_cast<float>(o.real("kdop_cost"));
+  costs.obb = static_cast<float>(o.real("obb_cost"));
   costs.block = static_cast<float>(o.real("block_cost"));
   GeometryReport report = validate(geometry);
   Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, bvh_config), geometry, bvh_config.merge_leaves);
-  BvhSphereFilters filters = choose_sphere_filters(bvh, costs, geometry.source);
+  BvhVolumeFilters filters = choose_volume_filters(bvh, costs, geometry.source);
   AccelStats stats = bvh_stats(geometry, report, bvh, start);
-  if (!filters.records.empty())
-    stats.device_bytes +=
-        filters.sphere_of.size() * sizeof(rtcl_i32) + filters.records.size() * sizeof(Bvh8Spheres);
+  stats.device_bytes += filters.device_bytes();
   std::vector<std::string> defines = bvh_defines(geometry, bvh);
-  if (!filters.records.empty()) defines.push_back("RTCL_BVH_SPHERES");
+  if (!filters.spheres.empty()) defines.push_back("RTCL_BVH_SPHERES");
+  if (!filters.kdops.empty()) defines.push_back("RTCL_BVH_KDOP");
+  if (!filters.obbs.empty()) defines.push_back("RTCL_BVH_OBB");
   return std::make_unique<MixedBvhAccel>(device, std::move(defines), bvh, filters, stats, config);
 }
 

@@ -1,21 +1,24 @@
 #include "rtcl/accel/bvh_volumes.hpp"
 
 #include <algorithm>
-#include <cfloat>
+#include <array>
 #include <cmath>
-#include <numbers>
+#include <optional>
 
 #include <glm/glm.hpp>
 
-#include "rtcl/bounds/sphere_bounds.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {
 
 namespace {
 
-// The vertices of every triangle below child reference `ref`; false when a
-// sphere primitive lies below it (no sphere filter for that child).
+// Options at a node: boxes alone (0) or kind k's filter (1 + k).
+constexpr int kOptions = 1 + kFilterKinds;
+
+// The vertices of every triangle below child reference `ref`, each once
+// (sorted); false when a sphere primitive lies below it (no filter for that
+// child).
 bool collect_vertices(const Bvh8& bvh, rtcl_i32 ref, std::vector<glm::vec3>& points) {
   points.clear();
   std::vector<rtcl_i32> todo{ref};
@@ -34,6 +37,11 @@ bool collect_vertices(const Bvh8& bvh, rtcl_i32 ref, std::vector<glm::vec3>& poi
       if (block.prim[lane] >= 0)
         for (int v = 0; v < 3; ++v) points.emplace_back(block.v[v][0][lane], block.v[v][1][lane], block.v[v][2][lane]);
   }
+  auto less = [](const glm::vec3& a, const glm::vec3& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  std::sort(points.begin(), points.end(), less);
+  points.erase(std::unique(points.begin(), points.end()), points.end());
   return !points.empty();
 }
 
@@ -42,75 +50,127 @@ Aabb lane_box(const Bvh8Node& node, int lane) {
           {node.bounds[3][lane], node.bounds[4][lane], node.bounds[5][lane]}};
 }
 
-// The record's radius: the sphere's, plus the ray-independent part of the
-// filter's margin (kernels/shared/sphere_filter8.h), rounded up to float.
-float widened_radius(const BoundingSphere& s) {
-  double r = static_cast<double>(s.radius) + 16.0 * FLT_EPSILON * static_cast<double>(s.reach);
-  auto f = static_cast<float>(r);
-  return static_cast<double>(f) < r ? std::nextafter(f, FLT_MAX) : f;
+double box_area(const Aabb& b) {
+  if (b.empty()) return 0.0;
+  glm::dvec3 e = glm::dvec3(b.upper) - glm::dvec3(b.lower);
+  return 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
+
+// What the bottom-up pass keeps per node.
+struct NodeTable {
+  std::array<std::optional<ChildVolumes>, RTCL_BLOCK_WIDTH> volumes;
+  std::array<std::array<double, kOptions>, RTCL_BLOCK_WIDTH> slot_area{};  // per lane and option
+  std::array<bool, kOptions> available{};
+  std::array<double, kOptions> below{};  // sum over children of their cost at this option's areas
+  double below_boxes = 0.0;              // the same, boxes only everywhere
+};
 
 }  // namespace
 
-BvhSphereFilters choose_sphere_filters(const Bvh8& bvh, const VolumeCosts& costs, const std::string& source) {
-  for (float c : {costs.sphere, costs.block})
+std::size_t BvhVolumeFilters::device_bytes() const {
+  if (empty()) return 0;
+  return filter_of.size() * sizeof(rtcl_i32) + spheres.size() * sizeof(Bvh8Spheres) +
+         kdops.size() * sizeof(Bvh8Kdop) + obbs.size() * sizeof(Bvh8Obb);
+}
+
+BvhVolumeFilters choose_volume_filters(const Bvh8& bvh, const VolumeCosts& costs, const std::string& source) {
+  for (float c : {costs.sphere, costs.kdop, costs.obb, costs.block})
     if (!(c >= 0.0f) || !std::isfinite(c))
       throw Error("bvh-mixed over " + source + ": test costs must be finite and >= 0 (sphere_cost " +
-                  std::to_string(costs.sphere) + ", block_cost " + std::to_string(costs.block) + ")");
-  BvhSphereFilters out;
-  out.sphere_of.assign(bvh.nodes.size(), -1);
-  std::vector<double> cost(bvh.nodes.size(), 0.0), plain_cost(bvh.nodes.size(), 0.0);
+                  std::to_string(costs.sphere) + ", kdop_cost " + std::to_string(costs.kdop) + ", obb_cost " +
+                  std::to_string(costs.obb) + ", block_cost " + std::to_string(costs.block) + ")");
+  BvhVolumeFilters out;
+  out.filter_of.assign(bvh.nodes.size(), RTCL_FILTER_NONE);
+  if (bvh.nodes.empty()) return out;
+  const double filter_cost[kOptions] = {0.0, costs.sphere, costs.kdop, costs.obb};
+
+  std::vector<NodeTable> table(bvh.nodes.size());
+  // A node's cost at entering area a: the cheapest available option.
+  auto node_cost = [&](std::size_t n, double a) {
+    double best = a + table[n].below[0];
+    for (int o = 1; o < kOptions; ++o)
+      if (table[n].available[static_cast<std::size_t>(o)])
+        best = std::fmin(best, a * (1.0 + filter_cost[o]) + table[n].below[static_cast<std::size_t>(o)]);
+    return best;
+  };
+  auto child_cost = [&](rtcl_i32 child, double a) {
+    return child >= 0 ? node_cost(static_cast<std::size_t>(child), a) : a * costs.block;
+  };
+  auto child_cost_boxes = [&](rtcl_i32 child, double a) {
+    return child >= 0 ? a + table[static_cast<std::size_t>(child)].below_boxes : a * costs.block;
+  };
+
   std::vector<glm::vec3> points;
-  const double box_cost = 1.0;
   for (std::size_t n = bvh.nodes.size(); n-- > 0;) {
     const Bvh8Node& node = bvh.nodes[n];
-    Aabb all;
-    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
-      if (node.child[lane] != RTCL_CHILD_EMPTY) all = merge(all, lane_box(node, lane));
-    double parent_area = all.area();
-    Bvh8Spheres record;
-    double plain = box_cost, plain_all = box_cost, filtered = box_cost + costs.sphere;
-    std::size_t lanes = 0;
+    NodeTable& t = table[n];
+    t.available[0] = true;
     for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
-      record.cx[lane] = record.cy[lane] = record.cz[lane] = 0.0f;
-      record.r[lane] = -1.0f;
       rtcl_i32 child = node.child[lane];
       if (child == RTCL_CHILD_EMPTY) continue;
-      double below = child >= 0 ? cost[static_cast<std::size_t>(child)] : costs.block;
-      double below_plain = child >= 0 ? plain_cost[static_cast<std::size_t>(child)] : costs.block;
-      double box_area = lane_box(node, lane).area();
-      double p = parent_area > 0.0 ? box_area / parent_area : 1.0;
-      plain += p * below;
-      plain_all += p * below_plain;
-      double p_filtered = p;
-      if (parent_area > 0.0 && collect_vertices(bvh, child, points)) {
-        BoundingSphere s = exact_sphere(points, source);
-        float r = widened_radius(s);
-        double sphere_area = 4.0 * std::numbers::pi * static_cast<double>(r) * r;
-        if (sphere_area < box_area) {
-          record.cx[lane] = s.center.x;
-          record.cy[lane] = s.center.y;
-          record.cz[lane] = s.center.z;
-          record.r[lane] = r;
-          p_filtered = sphere_area / parent_area;
-          ++lanes;
-        }
+      Aabb box = lane_box(node, lane);
+      auto& area = t.slot_area[static_cast<std::size_t>(lane)];
+      area.fill(box_area(box));
+      if (collect_vertices(bvh, child, points)) {
+        const ChildVolumes& v = t.volumes[static_cast<std::size_t>(lane)].emplace(child_volumes(box, points, source));
+        for (int k = 0; k < kFilterKinds; ++k)
+          if (v.used[k]) {
+            area[static_cast<std::size_t>(1 + k)] = v.area[k];
+            t.available[static_cast<std::size_t>(1 + k)] = true;
+          }
       }
-      filtered += p_filtered * below;
-    }
-    plain_cost[n] = plain_all;
-    if (lanes > 0 && filtered < plain) {
-      out.sphere_of[n] = static_cast<rtcl_i32>(out.records.size());
-      out.records.push_back(record);
-      out.sphere_lanes += lanes;
-      cost[n] = filtered;
-    } else {
-      cost[n] = plain;
+      for (int o = 0; o < kOptions; ++o) t.below[static_cast<std::size_t>(o)] += child_cost(child, area[static_cast<std::size_t>(o)]);
+      t.below_boxes += child_cost_boxes(child, area[0]);
     }
   }
-  if (!bvh.nodes.empty()) {
-    out.aabb_cost = plain_cost[0];
-    out.chosen_cost = cost[0];
+
+  // Top-down: each node's option at the area its parent's choice gives it.
+  Aabb root_box;
+  for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
+    if (bvh.nodes[0].child[lane] != RTCL_CHILD_EMPTY) root_box.grow(lane_box(bvh.nodes[0], lane));
+  double a_root = box_area(root_box);
+  std::vector<double> entering(bvh.nodes.size(), 0.0);
+  entering[0] = a_root;
+  for (std::size_t n = 0; n < bvh.nodes.size(); ++n) {
+    const NodeTable& t = table[n];
+    double a = entering[n];
+    int choice = 0;
+    double best = a + t.below[0];
+    for (int o = 1; o < kOptions; ++o) {
+      double c = a * (1.0 + filter_cost[o]) + t.below[static_cast<std::size_t>(o)];
+      if (t.available[static_cast<std::size_t>(o)] && c < best) {
+        best = c;
+        choice = o;
+      }
+    }
+    if (n == 0) {
+      double unit = a_root > 0.0 ? a_root : 1.0;
+      out.chosen_cost = (a_root > 0.0 ? best : 1.0) / unit;
+      out.aabb_cost = (a_root > 0.0 ? a + t.below_boxes : 1.0) / unit;
+    }
+    const Bvh8Node& node = bvh.nodes[n];
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
+      if (node.child[lane] >= 0)
+        entering[static_cast<std::size_t>(node.child[lane])] =
+            t.slot_area[static_cast<std::size_t>(lane)][static_cast<std::size_t>(choice)];
+    if (choice == 0) continue;
+    int kind = choice - 1;
+    std::size_t index = 0;
+    Bvh8Spheres sphere{};
+    Bvh8Kdop kdop{};
+    Bvh8Obb obb{};
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+      const auto& slot = t.volumes[static_cast<std::size_t>(lane)];
+      const ChildVolumes* v = slot ? &*slot : nullptr;
+      if (v != nullptr && v->used[kind]) ++out.lanes[kind];
+      if (kind == RTCL_FILTER_SPHERE) write_sphere_lane(sphere, lane, v);
+      if (kind == RTCL_FILTER_KDOP) write_kdop_lane(kdop, lane, v);
+      if (kind == RTCL_FILTER_OBB) write_obb_lane(obb, lane, v);
+    }
+    if (kind == RTCL_FILTER_SPHERE) index = out.spheres.size(), out.spheres.push_back(sphere);
+    if (kind == RTCL_FILTER_KDOP) index = out.kdops.size(), out.kdops.push_back(kdop);
+    if (kind == RTCL_FILTER_OBB) index = out.obbs.size(), out.obbs.push_back(obb);
+    out.filter_of[n] = RTCL_FILTER_REF(kind, static_cast<rtcl_i32>(index));
   }
   return out;
 }

@@ -1,18 +1,27 @@
 // Per-node bounding-volume choice for the 8-wide BVH (lecture, 层次包围体:
-// each node may choose its volume type). After the build, each node either
-// keeps its children's boxes alone or adds a second, float8 filter by the
-// children's exact bounding spheres (Welzl, rtcl/bounds/sphere_bounds.hpp),
-// whichever has the lower expected cost:
+// each node may choose its volume type). After the build, each node keeps
+// its children's boxes alone or adds one float8 filter of its children by
+// volumes of one kind (bvh_child_volumes.hpp): exact (Welzl) bounding
+// spheres, the body-diagonal slabs of the 14-DOP, or oriented boxes. The
+// choice is per node, not per child slot, because a filter's float8 test
+// costs the same for one lane as for eight: a node pays for each kind it
+// runs, so it runs at most one.
 //
-//   cost(node) = box + [sphere] + sum over children k of P_k * cost(k),
-//   P_k = area(volume_k) / area(node's box),
+// Expected cost (the SAH's, in units of one node's eight-box test): a ray
+// that meets a node's entering volume (its slot in the parent: the box, or
+// box ∩ filter volume) of area a costs, with kind K chosen at the node,
 //
-// where volume_k is child k's box, or with the filter the intersection of
-// its box and sphere (its area taken as the smaller of the two: an upper
-// bound, so the filter's gain is never overstated), area ratios being the
-// probability that a ray entering the node enters the child (Cauchy's
-// formula for convex bodies, the SAH's assumption), and cost(leaf) = block.
-// Decided bottom-up, so every child's cost is its chosen one.
+//   F(node, a) = a (1 + c_K) / a_root + sum over children k of F(k, area_K(k)),
+//   F(leaf, a) = a c_block / a_root,
+//
+// where area_K(k) is the area of child k's box ∩ its kind-K volume (its
+// box where the kind does not cut it), c_K its filter's cost (0 for boxes
+// alone), and area ratios are the probability that a ray meeting one
+// convex set meets another inside it (Cauchy's formula, the SAH's
+// assumption). Each node's cost is the minimum over kinds, a function of
+// its entering area a (a minimum of lines); it is tabulated bottom-up at
+// the four areas the parent can give it and chosen top-down from the
+// root's box.
 #pragma once
 
 #include <cstddef>
@@ -21,31 +30,40 @@
 #include <vector>
 
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/bvh_child_volumes.hpp"
 #include "rtcl/layouts.hpp"
 
 namespace rtcl {
 
 // Relative test costs, in units of one node's eight-box float8 slab test.
-// Defaults measured on PoCL (bench volume_cost/bunny/*, 65,536 diffuse rays
-// x 256 records, median of 3): box 107 ms, sphere filter 145 ms (1.36x),
-// triangle block 867 ms (8.1x).
+// Measured on PoCL (bench volume_cost/bunny/*: 65,536 of the bunny's
+// diffuse rays x 256 records, medians of three runs on the loaded 2-core
+// machine; README, "bvh-mixed"): sphere filter 0.7-1.4 (1.36 on a quieter
+// run), 14-DOP slabs 1.06-1.39, OBBs 1.5-2.0, triangle block 4.8-9.7 (8.1
+// on the quieter run). The defaults round those.
 struct VolumeCosts {
-  float sphere = 1.3f;  // the eight-sphere float8 filter of one node
+  float sphere = 1.3f;  // the eight-sphere filter of one node
+  float kdop = 1.3f;    // the eight 14-DOP diagonal-slab filter
+  float obb = 2.0f;     // the eight-OBB filter
   float block = 8.0f;   // one leaf block (eight triangle tests in float8)
 };
 
-struct BvhSphereFilters {
-  std::vector<rtcl_i32> sphere_of;  // per node: index into records, or -1
-  std::vector<Bvh8Spheres> records;
-  std::size_t sphere_lanes = 0;     // children with a sphere, over all records
-  double aabb_cost = 0.0;           // expected cost of a ray entering the root, boxes only
-  double chosen_cost = 0.0;         // the same with the chosen filters
+struct BvhVolumeFilters {
+  std::vector<rtcl_i32> filter_of;  // per node: RTCL_FILTER_REF(kind, record) or RTCL_FILTER_NONE
+  std::vector<Bvh8Spheres> spheres;
+  std::vector<Bvh8Kdop> kdops;
+  std::vector<Bvh8Obb> obbs;
+  std::size_t lanes[kFilterKinds] = {};  // per kind: children with a volume, over the chosen records
+  double aabb_cost = 0.0;    // expected cost of a ray meeting the root's box, boxes only
+  double chosen_cost = 0.0;  // the same with the chosen filters
+
+  bool empty() const { return spheres.empty() && kdops.empty() && obbs.empty(); }
+  std::size_t device_bytes() const;
 };
 
 // Chooses the filters for `bvh` (flatten_bvh8's output: children after
-// their parents). Children holding sphere primitives keep their box alone
-// (r < 0). Throws Error naming `source` for costs that are negative or not
-// finite.
-BvhSphereFilters choose_sphere_filters(const Bvh8& bvh, const VolumeCosts& costs, const std::string& source);
+// their parents). Children holding sphere primitives keep their box alone.
+// Throws Error naming `source` for costs that are negative or not finite.
+BvhVolumeFilters choose_volume_filters(const Bvh8& bvh, const VolumeCosts& costs, const std::string& source);
 
 }  // namespace rtcl

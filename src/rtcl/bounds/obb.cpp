@@ -43,8 +43,8 @@ glm::dmat3 rotated(const glm::dmat3& b, int k, double a) {
   return r;
 }
 
-Fit refine(const std::vector<glm::vec3>& points, Fit best) {
-  for (double step = 0.25; step >= 1e-5; step *= 0.5) {
+Fit refine(const std::vector<glm::vec3>& points, Fit best, double min_step) {
+  for (double step = 0.25; step >= min_step; step *= 0.5) {
     for (int sweep = 0; sweep < 64; ++sweep) {
       bool improved = false;
       for (int k = 0; k < 3; ++k)
@@ -117,7 +117,7 @@ double Obb::area() const {
 
 SlabVolume Obb::record() const { return slab_record(3, axis, d_near, d_far, reach); }
 
-Obb obb_of_points(const std::vector<glm::vec3>& points, const std::string& source) {
+Obb obb_of_points(const std::vector<glm::vec3>& points, const std::string& source, double min_step_rad) {
   check_points(points, source);
   glm::dvec3 mean(0.0);
   for (const glm::vec3& p : points) mean += glm::dvec3(p);
@@ -133,7 +133,7 @@ Obb obb_of_points(const std::vector<glm::vec3>& points, const std::string& sourc
   // world axes themselves (so the result is never larger than the AABB).
   Fit best = evaluate(points, glm::dmat3(1.0));
   for (const glm::dmat3& start : {pca, glm::dmat3(1.0)}) {
-    Fit f = evaluate(points, refine(support, evaluate(support, start)).basis);
+    Fit f = evaluate(points, refine(support, evaluate(support, start), min_step_rad).basis);
     if (f.area < best.area) best = f;
   }
 

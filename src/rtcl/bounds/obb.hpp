@@ -8,8 +8,8 @@
 // are extreme along 129 directions spread over the sphere (at most 258 of
 // them; the final extents are taken over all points), by coordinate descent
 // over rotations about its own three axes, with steps from 0.25 rad halved
-// down to 1e-5 rad, accepting a rotation only when it lowers the box's
-// surface area (the quantity a random ray's hit probability is proportional
+// down to min_step_rad (default 1e-5 rad), accepting a rotation only when it
+// lowers the box's surface area (the quantity a random ray's hit probability is proportional
 // to, and well defined for flat inputs, where every box has volume 0). Of
 // the two refined boxes and the AABB, measured on all points, the one with
 // the smallest area is kept, so the OBB's area never exceeds the AABB's.
@@ -40,7 +40,8 @@ struct Obb {
 };
 
 // Throws like check_points (point_input.hpp). One point or equal points give
-// a box of zero extent along the world axes.
-Obb obb_of_points(const std::vector<glm::vec3>& points, const std::string& source);
+// a box of zero extent along the world axes. A coarser min_step_rad trades
+// fit for time (each halving of it adds one round of the descent).
+Obb obb_of_points(const std::vector<glm::vec3>& points, const std::string& source, double min_step_rad = 1e-5);
 
 }  // namespace rtcl
