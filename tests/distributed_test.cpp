@@ -17,6 +17,7 @@
 #include "rtcl/error.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/scene/default_scene.hpp"
+#include "rtcl/scene/scene_file.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference_renderer.hpp"
 #include "support/temp_dir.hpp"
@@ -110,6 +111,33 @@ TEST(Distributed, SoftShadowsOfQuadDiscAndSphereLightsMatchTheReference) {
       expect_matches_reference(scene, settings(24, 2, sampler, 3),
                                "area light " + std::to_string(int(shape)) + ", " + std::string(sampler_name(sampler)));
     }
+}
+
+// The Cornell box lit by its own lamp (MTL Ke): one triangle light per
+// emitting triangle, against the reference.
+TEST(Distributed, EmissiveTrianglesOfTheCornellBoxAreAreaLights) {
+  Scene scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
+  scene.lights = {Light{}};
+  scene.lights[0].shape = LightShape::emissive;
+  scene.lights[0].intensity = 0.08f;
+  std::vector<Light> expanded = expand_emissive_lights(scene, flatten(scene));
+  ASSERT_EQ(expanded.size(), 2u) << "the lamp quad: two triangles";
+  EXPECT_EQ(expanded[0].shape, LightShape::triangle);
+  // area shares: the two halves of the lamp together carry its emission
+  glm::vec3 total = expanded[0].color + expanded[1].color;
+  EXPECT_NEAR(total.x, 17.0f, 1e-4f);
+  expect_matches_reference(scene, settings(24, 2, Sampler::sobol, 2), "cornell box, emissive lamp");
+
+  Scene dark = default_scene();
+  for (Material& m : dark.materials) m.emission = glm::vec3(0.0f);
+  dark.lights[0].shape = LightShape::emissive;
+  try {
+    Renderer(test_device(), dark, "brute");
+    ADD_FAILURE() << "an emissive light without emitters was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("lights[0]"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("emission"), std::string::npos) << e.what();
+  }
 }
 
 // A light of size zero is the point light: against the reference of the

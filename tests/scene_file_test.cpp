@@ -65,7 +65,7 @@ TEST(SceneFile, ShippedScenesLoad) {
   FlatScene flat = flatten(cornell);
   EXPECT_EQ(flat.geometry.primitive_count(), 38u);
   EXPECT_EQ(flat.material.size(), 38u);
-  for (const char* name : {"/scenes/sibenik.json", "/scenes/sponza.json"})
+  for (const char* name : {"/scenes/sibenik.json", "/scenes/sponza.json", "/scenes/cornell_soft.json"})
     EXPECT_NO_THROW(load_scene(std::string(RTCL_SOURCE_DIR) + name)) << name;
 }
 
@@ -114,13 +114,14 @@ TEST(SceneFile, AreaLightsLensAndRoughness) {
       "  \"lights\": [{\"type\": \"quad\", \"position\": [0, 2, 0], \"edge1\": [0.5, 0, 0], \"edge2\": [0, 0, 0.25]},\n"
       "             {\"type\": \"disc\", \"position\": [1, 2, 0], \"normal\": [0, -2, 0], \"radius\": 0.3},\n"
       "             {\"type\": \"sphere\", \"position\": [-1, 2, 0], \"radius\": 0.2, \"intensity\": 2},\n"
-      "             {\"position\": [0, 3, 0]}],\n"
+      "             {\"position\": [0, 3, 0]}, {\"type\": \"emissive\", \"intensity\": 0.1}],\n"
       "  \"materials\": {\"satin\": {\"kr\": 0.5, \"roughness\": 0.3}},\n"
       "  \"objects\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"satin\"}]\n}\n";
   Scene scene = load_scene(f.dir.write("scene.json", text));
   EXPECT_EQ(scene.camera.aperture, 0.1f);
   EXPECT_EQ(scene.camera.focus_distance, 4.0f);
-  ASSERT_EQ(scene.lights.size(), 4u);
+  ASSERT_EQ(scene.lights.size(), 5u);
+  EXPECT_EQ(scene.lights[4].shape, LightShape::emissive);
   EXPECT_EQ(scene.lights[0].shape, LightShape::quad);
   EXPECT_EQ(scene.lights[0].edge2, glm::vec3(0.0f, 0.0f, 0.25f));
   EXPECT_EQ(scene.lights[1].shape, LightShape::disc);
@@ -202,6 +203,8 @@ TEST(SceneFile, BadFilesGiveClearErrors) {
        {"lights[0].radius", "not a key of a quad light"}},
       {scene_text(glass, sphere, "  \"lights\": [{\"position\": [0, 1, 0], \"edge1\": [1, 0, 0]}],\n"),
        {"lights[0].edge1", "not a key of a point light"}},
+      {scene_text(glass, sphere, "  \"lights\": [{\"type\": \"emissive\", \"position\": [0, 1, 0]}],\n"),
+       {"lights[0].position", "not a key of an emissive light"}},
       {scene_text(glass, "{\"type\": \"sphere\", \"center\": [0, 0], \"radius\": 1, \"material\": \"glass\"}"),
        {"objects[0].center", "3 numbers"}},
       {scene_text(glass, "{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": -1, \"material\": \"glass\"}"),

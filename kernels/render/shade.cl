@@ -136,11 +136,19 @@ inline float fresnel_dielectric(float cos_i, float cos_t, float eta) {
 
 #ifdef RTCL_HAS_AREA_LIGHTS
 /* Point of light `l` for the shading point p at (u, v) in [0, 1)^2: a quad
- * uniformly by area, a disc by the concentric map, a sphere on the disc
- * through its centre facing p. */
+ * uniformly by area, a triangle by folding the unit square's upper half onto
+ * the lower (uniform by area), a disc by the concentric map, a sphere on the
+ * disc through its centre facing p. */
 inline float3 light_point(global const DeviceLight* l, float3 p, float u, float v) {
   float3 c = load3g(l->position);
   if (l->shape == RTCL_LIGHT_QUAD) return c + u * load3g(l->u) + v * load3g(l->v);
+  if (l->shape == RTCL_LIGHT_TRIANGLE) {
+    if (u + v > 1.0f) {
+      u = 1.0f - u;
+      v = 1.0f - v;
+    }
+    return c + u * load3g(l->u) + v * load3g(l->v);
+  }
   float x, y;
   rtcl_concentric_disc(u, v, &x, &y);
   if (l->shape == RTCL_LIGHT_DISC) return c + x * load3g(l->u) + y * load3g(l->v);

@@ -35,6 +35,7 @@ typedef struct DeviceMaterial {
 #define RTCL_LIGHT_QUAD 1u
 #define RTCL_LIGHT_DISC 2u
 #define RTCL_LIGHT_SPHERE 3u
+#define RTCL_LIGHT_TRIANGLE 4u
 
 /* A light: 56 bytes. radiance = colour * intensity, not attenuated with
  * distance (classic Whitted light). An area light is the average of point
@@ -42,9 +43,9 @@ typedef struct DeviceMaterial {
  * disc through its centre facing the shaded point), so a light of size zero
  * is the point light. */
 typedef struct DeviceLight {
-  float position[3]; /* point: the point; quad: a corner; disc, sphere: the centre */
+  float position[3]; /* point: the point; quad, triangle: a corner; disc, sphere: the centre */
   float radiance[3];
-  float u[3], v[3];  /* quad: its two edges from the corner; disc: two orthogonal radius vectors; else 0 */
+  float u[3], v[3];  /* quad, triangle: two edges from the corner; disc: two orthogonal radius vectors; else 0 */
   float radius;      /* sphere: its radius; else 0 */
   rtcl_u32 shape;    /* RTCL_LIGHT_* */
 } DeviceLight;

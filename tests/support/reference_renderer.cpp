@@ -37,6 +37,7 @@ class Tracer {
   Tracer(const Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {
     FlatScene flat = flatten(scene);
     material_ = flat.material;
+    lights_ = expand_emissive_lights(scene, flat);
     const Geometry& g = flat.geometry;
     for (std::size_t t = 0; t < g.triangles.size(); ++t) {
       Tri tri;
@@ -68,6 +69,13 @@ class Tracer {
     if (l.shape == LightShape::point) return c;
     if (l.shape == LightShape::quad)
       return c - 0.5 * (dvec3(l.edge1) + dvec3(l.edge2)) + u * dvec3(l.edge1) + v * dvec3(l.edge2);
+    if (l.shape == LightShape::triangle) {
+      if (u + v > 1.0) {  // the kernel's fold, on the same float sample values
+        u = 1.0 - u;
+        v = 1.0 - v;
+      }
+      return c + u * dvec3(l.edge1) + v * dvec3(l.edge2);
+    }
     float fx, fy;
     rtcl_concentric_disc(static_cast<float>(u), static_cast<float>(v), &fx, &fy);
     double x = fx, y = fy;
@@ -109,9 +117,9 @@ class Tracer {
     dvec3 above = p + offset * n;
     dvec3 radiance = w * (dvec3(m.emission) + dvec3(scene_.ambient) * dvec3(m.ambient));
 
-    const auto light_count = static_cast<std::uint32_t>(scene_.lights.size());
+    const auto light_count = static_cast<std::uint32_t>(lights_.size());
     for (std::uint32_t l = 0; l < light_count; ++l) {
-      const Light& light = scene_.lights[l];
+      const Light& light = lights_[l];
       std::uint32_t points = light.area() ? settings_.light_samples : 1u;
       for (std::uint32_t j = 0; j < points; ++j) {
         double u = 0.0, v = 0.0;
@@ -237,6 +245,7 @@ class Tracer {
   const Scene& scene_;
   RenderSettings settings_;
   std::vector<std::uint32_t> material_;
+  std::vector<Light> lights_;  // emissive lights expanded into triangles
   std::vector<Tri> triangles_;
   std::vector<Ball> spheres_;
 };

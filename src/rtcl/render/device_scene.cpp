@@ -35,6 +35,8 @@ std::uint32_t shape_code(LightShape shape) {
     case LightShape::quad: return RTCL_LIGHT_QUAD;
     case LightShape::disc: return RTCL_LIGHT_DISC;
     case LightShape::sphere: return RTCL_LIGHT_SPHERE;
+    case LightShape::triangle: return RTCL_LIGHT_TRIANGLE;
+    case LightShape::emissive:  // expanded into triangles before upload
     case LightShape::point: break;
   }
   return RTCL_LIGHT_POINT;
@@ -49,7 +51,7 @@ DeviceLight pack(const Light& l) {
   store(d.position, glm::vec3(position));
   store(d.radiance, l.color * l.intensity);
   d.shape = shape_code(l.shape);
-  if (l.shape == LightShape::quad) {
+  if (l.shape == LightShape::quad || l.shape == LightShape::triangle) {
     store(d.u, l.edge1);
     store(d.v, l.edge2);
   }

@@ -87,8 +87,9 @@ struct Renderer::State {
 Renderer::Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config)
     : s_(std::make_unique<State>(device, scene)) {
   s_->flat = flatten(scene);
+  s_->scene.lights = expand_emissive_lights(scene, s_->flat);
   s_->accel = make_accel(device, accel_name, s_->flat.geometry, config);
-  s_->shading = upload_scene(device, scene, s_->flat);
+  s_->shading = upload_scene(device, s_->scene, s_->flat);
   s_->queue.specialise_generation(s_->shading.generate_defines);
   s_->next.specialise_generation(s_->shading.generate_defines);
   if (config.precision == Precision::fast) s_->shading.defines.push_back("RTCL_FIXED_SPAWN_OFFSET");

@@ -132,6 +132,48 @@ FlatScene flatten(const Scene& scene) {
   return flat;
 }
 
+std::vector<Light> expand_emissive_lights(const Scene& scene, const FlatScene& flat) {
+  std::vector<Light> out;
+  const Geometry& g = flat.geometry;
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    if (l.shape != LightShape::emissive) {
+      out.push_back(l);
+      continue;
+    }
+    struct Emitter {
+      glm::dvec3 v0, e1, e2;
+      glm::vec3 emission;
+      double area;
+    };
+    std::vector<Emitter> emitters;
+    double total = 0.0;
+    for (std::size_t t = 0; t < g.triangles.size(); ++t) {
+      const Material& m = scene.materials[flat.material[t]];
+      if (!glm::any(glm::greaterThan(m.emission, glm::vec3(0.0f)))) continue;
+      glm::dvec3 v0(g.vertices[g.triangles[t][0]]), v1(g.vertices[g.triangles[t][1]]), v2(g.vertices[g.triangles[t][2]]);
+      double area = 0.5 * glm::length(glm::cross(v1 - v0, v2 - v0));
+      if (!(area > 0.0)) continue;
+      emitters.push_back({v0, v1 - v0, v2 - v0, m.emission, area});
+      total += area;
+    }
+    if (emitters.empty())
+      throw Error(scene.source + ": lights[" + std::to_string(i) +
+                  "]: an emissive light, but no triangle's material has emission > 0");
+    for (const Emitter& e : emitters) {
+      Light t;
+      t.shape = LightShape::triangle;
+      t.position = glm::vec3(e.v0);
+      t.edge1 = glm::vec3(e.e1);
+      t.edge2 = glm::vec3(e.e2);
+      t.color = glm::vec3(glm::dvec3(e.emission) * glm::dvec3(l.color) * (e.area / total));
+      t.intensity = l.intensity;
+      out.push_back(t);
+    }
+  }
+  return out;
+}
+
 Scene transform_scene(const Scene& scene, const glm::dmat4& t) {
   double s = similarity_scale(t, scene.source);
   Scene out = scene;

@@ -39,18 +39,22 @@ struct Material {
   bool glossy() const { return roughness > 0.0f && (reflective() || transmissive()); }
 };
 
-enum class LightShape { point, quad, disc, sphere };
+// emissive: every triangle whose material has emission > 0 lights the scene
+// (expand_emissive_lights turns it into one triangle light per triangle).
+enum class LightShape { point, quad, disc, sphere, emissive, triangle };
 
-// A light. An area light (quad, disc, sphere) is the average of point lights
-// of its radiance over its points, uniformly by area (a sphere: over the disc
-// through its centre that faces the shaded point): soft shadows, and a light
-// of size zero is the point light.
+// A light. An area light (quad, disc, sphere, triangle) is the average of
+// point lights of its radiance over its points, uniformly by area (a sphere:
+// over the disc through its centre that faces the shaded point): soft
+// shadows, and a light of size zero is the point light. An emissive light's
+// radiance at a triangle's point is the triangle's emission times color times
+// intensity.
 struct Light {
-  glm::vec3 position{0.0f};  // point: the point; quad, disc, sphere: the centre
+  glm::vec3 position{0.0f};  // point: the point; quad, disc, sphere: the centre; triangle: a corner
   glm::vec3 color{1.0f};
   float intensity = 1.0f;  // radiance = color * intensity, no distance falloff
   LightShape shape = LightShape::point;
-  glm::vec3 edge1{0.0f}, edge2{0.0f};  // quad: its two edge vectors (full lengths)
+  glm::vec3 edge1{0.0f}, edge2{0.0f};  // quad: its two edge vectors (full lengths); triangle: from the corner
   glm::vec3 normal{0.0f, -1.0f, 0.0f};  // disc: its normal (non-zero; either side lights alike)
   float radius = 0.0f;                  // disc, sphere: >= 0
   bool area() const { return shape != LightShape::point; }
@@ -121,6 +125,13 @@ struct FlatScene {
   std::vector<std::uint32_t> material;
 };
 FlatScene flatten(const Scene& scene);
+
+// scene.lights with each emissive light replaced by one triangle light per
+// emitting triangle of `flat` (in primitive order), each of radiance emission
+// * color * intensity times its share of the emitters' total area (so that
+// together they are the average over the emitters' points). Throws Error
+// naming the light when no triangle emits.
+std::vector<Light> expand_emissive_lights(const Scene& scene, const FlatScene& flat);
 
 // The scene moved by a similarity transform (rotation, uniform scale,
 // translation): camera, lights, meshes and spheres. Throws Error when

@@ -151,15 +151,17 @@ Light read_light(const Reader& r, const json& v, const std::string& where) {
   else if (type == "quad") l.shape = LightShape::quad;
   else if (type == "disc") l.shape = LightShape::disc;
   else if (type == "sphere") l.shape = LightShape::sphere;
-  else r.fail(Reader::join(where, "type"), "unknown light type '" + type + "' (known: point, quad, disc, sphere)");
+  else if (type == "emissive") l.shape = LightShape::emissive;
+  else r.fail(Reader::join(where, "type"), "unknown light type '" + type + "' (known: point, quad, disc, sphere, emissive)");
   // The keys each shape takes (beyond position, color, intensity, type).
   auto allow = [&](const char* key, bool allowed) {
-    if (v.contains(key) && !allowed) r.fail(Reader::join(where, key), "not a key of a " + type + " light");
+    if (v.contains(key) && !allowed) r.fail(Reader::join(where, key), "not a key of " + std::string(type == "emissive" ? "an " : "a ") + type + " light");
   };
   allow("edge1", l.shape == LightShape::quad);
   allow("edge2", l.shape == LightShape::quad);
   allow("normal", l.shape == LightShape::disc);
   allow("radius", l.shape == LightShape::disc || l.shape == LightShape::sphere);
+  allow("position", l.shape != LightShape::emissive);
   if (l.shape == LightShape::quad) {
     l.edge1 = to_float(r.vec3(r.required(v, where, "edge1"), Reader::join(where, "edge1")));
     l.edge2 = to_float(r.vec3(r.required(v, where, "edge2"), Reader::join(where, "edge2")));
@@ -174,7 +176,8 @@ Light read_light(const Reader& r, const json& v, const std::string& where) {
     if (!(radius >= 0.0)) r.fail(Reader::join(where, "radius"), "must not be negative (0: a point light), got " + v["radius"].dump());
     l.radius = static_cast<float>(radius);
   }
-  l.position = to_float(r.vec3(r.required(v, where, "position"), Reader::join(where, "position")));
+  if (l.shape != LightShape::emissive)
+    l.position = to_float(r.vec3(r.required(v, where, "position"), Reader::join(where, "position")));
   if (v.contains("color")) l.color = to_float(r.triple(v["color"], Reader::join(where, "color")));
   if (v.contains("intensity")) l.intensity = static_cast<float>(r.number(v["intensity"], Reader::join(where, "intensity")));
   if (l.intensity < 0.0f) r.fail(Reader::join(where, "intensity"), "must not be negative");
