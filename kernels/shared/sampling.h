@@ -18,7 +18,7 @@
  *    dimension, except the sub-pixel dimension; one sample in the sub-pixel
  *    dimension is the pixel centre;
  *  - sobol: the first two dimensions of the Sobol sequence, Owen-scrambled
- *    (nested uniform scrambling, Owen 1995) per pixel and dimension, the
+ *    (Owen 1995, hash-based) per pixel and dimension, the
  *    index shuffled per pixel and dimension within the next power of two
  *    (Burley, "Practical Hash-based Owen Scrambling", JCGT 2020): for count
  *    = 2^m the points of a pixel's dimension form a (0, m, 2)-net.
@@ -110,22 +110,6 @@ inline rtcl_u32 rtcl_permute(rtcl_u32 i, rtcl_u32 n, rtcl_u32 key) {
   return i;
 }
 
-/* Nested uniform (Owen) scrambling of a 32-bit binary fraction: bit b (from
- * the top) flips by a random bit of the node that bits above it name in the
- * binary tree of intervals, for the top 24 bits (all a float keeps); the low
- * 8 bits are random. Keeps the stratification of any (t, m, s)-net. */
-inline rtcl_u32 rtcl_owen_scramble(rtcl_u32 x, rtcl_u32 key) {
-  rtcl_u32 out = x;
-  for (rtcl_u32 level = 0; level < 24u; ++level) {
-    rtcl_u32 b = 31u - level;
-    rtcl_u32 prefix = level == 0u ? 0u : x >> (b + 1u);
-    rtcl_u32 node = prefix | (1u << level);
-    out ^= (rtcl_hash(node ^ key) & 1u) << b;
-  }
-  rtcl_u32 low = rtcl_hash((x >> 8) ^ key ^ 0x5bd1e995u) & 0xffu;
-  return (out & 0xffffff00u) | low;
-}
-
 /* Sobol dimensions 1 and 2 of point i (dimension 1: the van der Corput
  * sequence, bit-reversed i; dimension 2: direction numbers of Pascal's matrix
  * mod 2, v_{k+1} = v_k xor v_k >> 1) as 32-bit fractions. */
@@ -137,6 +121,24 @@ inline rtcl_u32 rtcl_reverse_bits(rtcl_u32 x) {
   x = ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
   return x;
 }
+/* Owen scrambling of a 32-bit binary fraction, hash-based (Burley,
+ * "Practical Hash-based Owen Scrambling", JCGT 2020, after Laine and Karras
+ * 2011): with the bits reversed, adding the key and xoring x with x times an
+ * even constant change each bit only by a function of the bits below it, so
+ * in the fraction's order each bit flips by a function of the bits above it
+ * (the digits naming its interval): the structure of nested uniform
+ * scrambling, which keeps the stratification of any (t, m, s)-net. Four
+ * multiplications instead of a hash per bit. */
+inline rtcl_u32 rtcl_owen_scramble(rtcl_u32 x, rtcl_u32 key) {
+  x = rtcl_reverse_bits(x);
+  x += key;
+  x ^= x * 0x6c50b47cu;
+  x ^= x * 0xb82f1e52u;
+  x ^= x * 0xc7afe638u;
+  x ^= x * 0x8d22f6e6u;
+  return rtcl_reverse_bits(x);
+}
+/* Sobol dimension 2 of point i (above). */
 inline rtcl_u32 rtcl_sobol_second(rtcl_u32 i) {
   rtcl_u32 r = 0u;
   for (rtcl_u32 v = 0x80000000u; i != 0u; i >>= 1, v ^= v >> 1)
