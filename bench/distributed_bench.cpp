@@ -1,6 +1,6 @@
 // The distributed ray tracer's speed/accuracy trade on the Cornell box lit
 // by its own lamp (emissive triangles as area lights), with a glossy sphere,
-// a glass sphere and a thin lens: time against error for spp 1, 4, 16, 64
+// a glass sphere and a thin lens: time against error for spp 1, 4, 16, 32, 64
 // per sampler. Error: RMSE of the display values (each channel clamped to
 // [0, 1], as the PNG shows them; the lamp's radiance, 17, would otherwise
 // dominate) against a converged image of the same renderer (1024 spp, Sobol,
@@ -131,7 +131,7 @@ void distributed_benchmark(benchmark::State& state, Sampler sampler, std::uint32
 
 [[maybe_unused]] const bool registered = [] {
   for (Sampler sampler : {Sampler::random, Sampler::stratified, Sampler::sobol})
-    for (std::uint32_t spp : {1u, 4u, 16u, 64u})
+    for (std::uint32_t spp : {1u, 4u, 16u, 32u, 64u})
       benchmark::RegisterBenchmark(
           ("distributed/cornell/" + std::string(sampler_name(sampler)) + "/spp:" + std::to_string(spp)).c_str(),
           distributed_benchmark, sampler, spp)
