@@ -5,8 +5,9 @@
 // [0, 1], as the PNG shows them; the lamp's radiance, 17, would otherwise
 // dominate) against a converged image of the same renderer (1024 spp, Sobol,
 // another seed), rendered once outside the timed region. Size
-// $RTCL_BENCH_DIST_RES squared (default 96); 1 light sample per pixel
-// sample, depth 5.
+// $RTCL_BENCH_DIST_RES squared (default 96); depth 5; 1 light sample per
+// pixel sample, and ".../spp:<n>/light:<k>": k light samples (shadow rays
+// instead of whole paths, for the soft shadows only).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -73,8 +74,9 @@ Scene cornell_soft() {
   return scene;
 }
 
-RenderSettings settings(std::uint32_t spp, Sampler sampler, std::uint32_t seed) {
+RenderSettings settings(std::uint32_t spp, Sampler sampler, std::uint32_t seed, std::uint32_t light_samples = 1) {
   RenderSettings s;
+  s.light_samples = light_samples;
   s.width = s.height = image_size();
   s.spp = spp;
   s.sampler = sampler;
@@ -107,14 +109,14 @@ Fixture& fixture() {
   return f;
 }
 
-void distributed_benchmark(benchmark::State& state, Sampler sampler, std::uint32_t spp) {
+void distributed_benchmark(benchmark::State& state, Sampler sampler, std::uint32_t spp, std::uint32_t light_samples) {
   try {
     Fixture& f = fixture();
-    f.renderer->render(settings(spp, sampler, 0));  // warm-up
+    f.renderer->render(settings(spp, sampler, 0, light_samples));  // warm-up
     double sq = 0.0, ms = 0.0;
     std::uint32_t seed = 1;
     for (auto _ : state) {
-      Image image = f.renderer->render(settings(spp, sampler, seed++));  // another seed per iteration
+      Image image = f.renderer->render(settings(spp, sampler, seed++, light_samples));  // another seed per iteration
       const double rmse = display_rmse(image, f.converged);
       state.SetIterationTime(f.renderer->stats().render_ms * 1e-3);
       sq += rmse * rmse;
@@ -130,14 +132,19 @@ void distributed_benchmark(benchmark::State& state, Sampler sampler, std::uint32
 }
 
 [[maybe_unused]] const bool registered = [] {
+  struct Point {
+    std::uint32_t spp, light_samples;
+  };
+  const Point points[] = {{1, 1}, {4, 1}, {16, 1}, {32, 1}, {64, 1}, {4, 4}, {4, 16}, {16, 4}};
   for (Sampler sampler : {Sampler::random, Sampler::stratified, Sampler::sobol})
-    for (std::uint32_t spp : {1u, 4u, 16u, 32u, 64u})
-      benchmark::RegisterBenchmark(
-          ("distributed/cornell/" + std::string(sampler_name(sampler)) + "/spp:" + std::to_string(spp)).c_str(),
-          distributed_benchmark, sampler, spp)
+    for (const Point& p : points) {
+      std::string name = "distributed/cornell/" + std::string(sampler_name(sampler)) + "/spp:" + std::to_string(p.spp);
+      if (p.light_samples > 1) name += "/light:" + std::to_string(p.light_samples);
+      benchmark::RegisterBenchmark(name.c_str(), distributed_benchmark, sampler, p.spp, p.light_samples)
           ->UseManualTime()
           ->Iterations(4)
           ->Unit(benchmark::kMillisecond);
+    }
   return true;
 }();
 

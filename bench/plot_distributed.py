@@ -19,7 +19,8 @@ from collections import defaultdict
 
 
 def load(path):
-    """{sampler: {spp: (median frame ms, rmse)}}."""
+    """{sampler: {spp: (median frame ms, rmse)}} for 1 light sample, and
+    {(sampler, spp, light samples): (median frame ms, rmse)} for more."""
     with open(path) as f:
         data = json.load(f)
     reps = defaultdict(list)
@@ -31,12 +32,17 @@ def load(path):
         if parts[0] != "distributed" or len(parts) < 4:
             continue
         sampler, spp = parts[2], int(parts[3].split(":")[1])
-        reps[(sampler, spp)].append(b["frame_ms"])
-        rmse[(sampler, spp)] = b["rmse"]
-    out = defaultdict(dict)
-    for (sampler, spp), times in reps.items():
-        out[sampler][spp] = (statistics.median(times), rmse[(sampler, spp)])
-    return out
+        light = int(parts[4].split(":")[1]) if len(parts) > 4 and parts[4].startswith("light:") else 1
+        reps[(sampler, spp, light)].append(b["frame_ms"])
+        rmse[(sampler, spp, light)] = b["rmse"]
+    out, lights = defaultdict(dict), {}
+    for (sampler, spp, light), times in reps.items():
+        value = (statistics.median(times), rmse[(sampler, spp, light)])
+        if light == 1:
+            out[sampler][spp] = value
+        else:
+            lights[(sampler, spp, light)] = value
+    return out, lights
 
 
 def time_to_reach(points, target):
@@ -55,7 +61,7 @@ def main():
     ap.add_argument("json")
     ap.add_argument("-o", "--output")
     args = ap.parse_args()
-    data = load(args.json)
+    data, lights = load(args.json)
     samplers = [s for s in ("random", "stratified", "sobol") if s in data]
     spps = sorted({spp for s in samplers for spp in data[s]})
     print("| spp | " + " | ".join(f"{s} ms | {s} RMSE" for s in samplers) + " |")
@@ -66,6 +72,10 @@ def main():
             t, e = data[s].get(spp, (float("nan"), float("nan")))
             cells += [f"{t:.1f}", f"{e:.4f}"]
         print(f"| {spp} | " + " | ".join(cells) + " |")
+    if lights:
+        print("\n| sampler | spp | light samples | ms | RMSE |\n|---|--:|--:|--:|--:|")
+        for (sampler, spp, light), (t, e) in sorted(lights.items()):
+            print(f"| {sampler} | {spp} | {light} | {t:.1f} | {e:.4f} |")
     if "random" in data:
         top = max(data["random"])
         t_ref, e_ref = data["random"][top]

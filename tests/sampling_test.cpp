@@ -149,6 +149,15 @@ TEST(Sampling, PermutationsAreBijections) {
     }
 }
 
+TEST(Sampling, CeilSqrtIsExact) {
+  for (std::uint32_t n = 1; n < 70000; ++n)
+    ASSERT_EQ(rtcl_ceil_sqrt(n), std::uint32_t(std::ceil(std::sqrt(double(n))))) << n;
+  for (std::uint32_t k : {1000u, 46339u, 46340u})
+    for (std::uint32_t n : {k * k - 1u, k * k, k * k + 1u})
+      EXPECT_EQ(rtcl_ceil_sqrt(n), std::uint32_t(std::ceil(std::sqrt(double(n))))) << n;
+  EXPECT_EQ(rtcl_ceil_sqrt(2147483647u), 46341u);
+}
+
 // Radially symmetric Gaussian of sigma s truncated at R: P(r < x) =
 // (1 - exp(-x^2 / 2s^2)) / (1 - exp(-R^2 / 2s^2)).
 TEST(Sampling, GaussianFilterOffsetsFollowTheTruncatedGaussian) {

@@ -129,6 +129,8 @@ RTCL_PROBE_VALUE(rtcl_dimension_light(3u, 2u, 1u)) RTCL_PROBE_VALUE(rtcl_dimensi
 RTCL_PROBE_VALUE(rtcl_owen_scramble(0x9e3779b9u, 77u)) RTCL_PROBE_VALUE(rtcl_sobol_second(12345u))
 RTCL_PROBE_VALUE(rtcl_reverse_bits(12345u)) RTCL_PROBE_VALUE(rtcl_permute(5u, 11u, 99u))
 RTCL_PROBE_VALUE(rtcl_mix_bits(5u, 4u, 99u)) RTCL_PROBE_VALUE(rtcl_sample_key(1u, 2u, 3u, 4u))
+RTCL_PROBE_VALUE(rtcl_ceil_sqrt(2147395600u)) RTCL_PROBE_VALUE(rtcl_ceil_sqrt(2147395601u))
+RTCL_PROBE_VALUE(rtcl_ceil_sqrt(1u)) RTCL_PROBE_VALUE(rtcl_ceil_sqrt(24u))
 
 RTCL_PROBE_RECORD(SlabVolume)
 RTCL_PROBE_FIELD(SlabVolume, normal) RTCL_PROBE_FIELD(SlabVolume, normal[12][3])

@@ -146,6 +146,15 @@ inline rtcl_u32 rtcl_sobol_second(rtcl_u32 i) {
   return r;
 }
 
+/* The smallest k with k * k >= n (n < 2^31), exact whatever the rounding of
+ * the device's sqrt. */
+inline rtcl_u32 rtcl_ceil_sqrt(rtcl_u32 n) {
+  rtcl_u32 k = (rtcl_u32)RTCL_SQRTF((float)n);
+  while (k > 0u && k * k > n) --k;
+  while ((k + 1u) * (k + 1u) <= n) ++k;
+  return k * k < n ? k + 1u : k;
+}
+
 /* Point `index` (< count) of `pixel` in `dimension`, in [0, 1)^2. */
 inline void rtcl_sample_2d(rtcl_u32 sampler, rtcl_u32 seed, rtcl_u32 pixel, rtcl_u32 dimension, rtcl_u32 index,
                            rtcl_u32 count, float* u, float* v) {
@@ -173,8 +182,7 @@ inline void rtcl_sample_2d(rtcl_u32 sampler, rtcl_u32 seed, rtcl_u32 pixel, rtcl
   rtcl_u32 stratum = dimension == RTCL_DIM_PIXEL ? index : rtcl_permute(index, count, key);
   rtcl_u32 h1 = rtcl_hash(key ^ rtcl_hash(index + 0x632be5abu));
   float ju = rtcl_unit_float(h1), jv = rtcl_unit_float(rtcl_hash(h1 ^ 0x68bc21ebu));
-  rtcl_u32 k = 1u;
-  while (k * k < count) ++k;
+  rtcl_u32 k = rtcl_ceil_sqrt(count);
   if (k * k == count) {
     float inv_k = 1.0f / (float)k;
     *u = ((float)(stratum % k) + ju) * inv_k;
