@@ -65,7 +65,7 @@ TEST(SceneFile, ShippedScenesLoad) {
   FlatScene flat = flatten(cornell);
   EXPECT_EQ(flat.geometry.primitive_count(), 38u);
   EXPECT_EQ(flat.material.size(), 38u);
-  for (const char* name : {"/scenes/sibenik.json", "/scenes/sponza.json"})
+  for (const char* name : {"/scenes/sibenik.json", "/scenes/sponza.json", "/scenes/cornell_soft.json"})
     EXPECT_NO_THROW(load_scene(std::string(RTCL_SOURCE_DIR) + name)) << name;
 }
 
@@ -105,6 +105,33 @@ TEST(SceneFile, TransformsMaterialsAndRelativePaths) {
   EXPECT_NEAR(mtl.kt.x, 0.75f, 1e-6f) << "kt = 1 - d";
   EXPECT_EQ(scene.materials[flat.material[1]].name, "glass");
   EXPECT_EQ(scene.materials[flat.material[2]].name, "glass");
+}
+
+TEST(SceneFile, AreaLightsLensAndRoughness) {
+  Files f;
+  std::string text =
+      "{\n  \"camera\": {\"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"aperture\": 0.1, \"focus_distance\": 4},\n"
+      "  \"lights\": [{\"type\": \"quad\", \"position\": [0, 2, 0], \"edge1\": [0.5, 0, 0], \"edge2\": [0, 0, 0.25]},\n"
+      "             {\"type\": \"disc\", \"position\": [1, 2, 0], \"normal\": [0, -2, 0], \"radius\": 0.3},\n"
+      "             {\"type\": \"sphere\", \"position\": [-1, 2, 0], \"radius\": 0.2, \"intensity\": 2},\n"
+      "             {\"position\": [0, 3, 0]}, {\"type\": \"emissive\", \"intensity\": 0.1}],\n"
+      "  \"materials\": {\"satin\": {\"kr\": 0.5, \"roughness\": 0.3}},\n"
+      "  \"objects\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"satin\"}]\n}\n";
+  Scene scene = load_scene(f.dir.write("scene.json", text));
+  EXPECT_EQ(scene.camera.aperture, 0.1f);
+  EXPECT_EQ(scene.camera.focus_distance, 4.0f);
+  ASSERT_EQ(scene.lights.size(), 5u);
+  EXPECT_EQ(scene.lights[4].shape, LightShape::emissive);
+  EXPECT_EQ(scene.lights[0].shape, LightShape::quad);
+  EXPECT_EQ(scene.lights[0].edge2, glm::vec3(0.0f, 0.0f, 0.25f));
+  EXPECT_EQ(scene.lights[1].shape, LightShape::disc);
+  EXPECT_EQ(scene.lights[1].normal, glm::vec3(0.0f, -2.0f, 0.0f));
+  EXPECT_EQ(scene.lights[1].radius, 0.3f);
+  EXPECT_EQ(scene.lights[2].shape, LightShape::sphere);
+  EXPECT_EQ(scene.lights[3].shape, LightShape::point);
+  ASSERT_EQ(scene.materials.size(), 1u);
+  EXPECT_EQ(scene.materials[0].roughness, 0.3f);
+  EXPECT_TRUE(scene.materials[0].glossy());
 }
 
 TEST(SceneFile, PlyAndStlMeshes) {
@@ -160,7 +187,24 @@ TEST(SceneFile, BadFilesGiveClearErrors) {
       {scene_text(glass, sphere, "  \"lights\": [{\"position\": [0, 1, 0], \"intensity\": \"bright\"}],\n"),
        {"lights[0].intensity", "expected a number, got string"}},
       {scene_text(glass, sphere, "  \"ambiant\": 0.1,\n"), {"ambiant", "unknown key"}},
-      {scene_text("\"glass\": {\"kt\": 1, \"roughness\": 0.5}", sphere), {"materials.glass.roughness", "unknown key"}},
+      {scene_text("\"glass\": {\"kt\": 1, \"rougness\": 0.5}", sphere), {"materials.glass.rougness", "unknown key"}},
+      {scene_text("\"glass\": {\"kt\": 1, \"roughness\": 1.5}", sphere), {"materials.glass.roughness", "[0, 1]", "1.5"}},
+      {scene_text("\"glass\": {\"kt\": 1, \"roughness\": -0.1}", sphere), {"materials.glass.roughness", "[0, 1]"}},
+      {scene_text(glass, sphere, "  \"lights\": [{\"type\": \"tube\", \"position\": [0, 1, 0]}],\n"),
+       {"lights[0].type", "unknown light type 'tube'", "quad"}},
+      {scene_text(glass, sphere, "  \"lights\": [{\"type\": \"sphere\", \"position\": [0, 1, 0], \"radius\": -1}],\n"),
+       {"lights[0].radius", "must not be negative"}},
+      {scene_text(glass, sphere, "  \"lights\": [{\"type\": \"disc\", \"position\": [0, 1, 0], \"radius\": 1, "
+                                 "\"normal\": [0, 0, 0]}],\n"),
+       {"lights[0].normal", "must not be zero"}},
+      {scene_text(glass, sphere, "  \"lights\": [{\"type\": \"disc\", \"position\": [0, 1, 0], \"radius\": 1}],\n"),
+       {"lights[0]", "missing required key 'normal'"}},
+      {scene_text(glass, sphere, "  \"lights\": [{\"type\": \"quad\", \"position\": [0, 1, 0], \"radius\": 1}],\n"),
+       {"lights[0].radius", "not a key of a quad light"}},
+      {scene_text(glass, sphere, "  \"lights\": [{\"position\": [0, 1, 0], \"edge1\": [1, 0, 0]}],\n"),
+       {"lights[0].edge1", "not a key of a point light"}},
+      {scene_text(glass, sphere, "  \"lights\": [{\"type\": \"emissive\", \"position\": [0, 1, 0]}],\n"),
+       {"lights[0].position", "not a key of an emissive light"}},
       {scene_text(glass, "{\"type\": \"sphere\", \"center\": [0, 0], \"radius\": 1, \"material\": \"glass\"}"),
        {"objects[0].center", "3 numbers"}},
       {scene_text(glass, "{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": -1, \"material\": \"glass\"}"),
@@ -178,6 +222,11 @@ TEST(SceneFile, BadFilesGiveClearErrors) {
        {"camera", "same point"}},
       {"{\"camera\": {\"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"fov\": 200}, \"objects\": [" + tri + "]}",
        {"camera.fov", "(0, 180)"}},
+      {"{\"camera\": {\"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"aperture\": -0.1}, \"objects\": [" + tri + "]}",
+       {"camera.aperture", "must not be negative", "-0.1"}},
+      {"{\"camera\": {\"position\": [0, 0, 5], \"look_at\": [0, 0, 0], \"focus_distance\": 0}, \"objects\": [" + tri +
+           "]}",
+       {"camera.focus_distance", "must be positive"}},
       {"{\"camera\": {\"position\": [0, 0, 5], \"position\": [0, 0, 4], \"look_at\": [0, 0, 0]}, \"objects\": [" + tri +
            "]}",
        {"duplicate key 'position'"}},

@@ -1,5 +1,5 @@
 /* Every record, field and size convention that crosses the host/device
- * boundary (kernels/shared/layouts.h, render_layouts.h, bounds_layouts.h), in
+ * boundary (kernels/shared/layouts.h, render_layouts.h, sampling.h, bounds_layouts.h), in
  * one list read by both kernels/probe/layout_probe.cl and
  * tests/layout_probe_test.cpp, which define the three entry kinds:
  *   RTCL_PROBE_RECORD(T)          sizeof(T) and the stride of a T array
@@ -88,20 +88,27 @@ RTCL_PROBE_FIELD(DeviceMaterial, ambient) RTCL_PROBE_FIELD(DeviceMaterial, diffu
 RTCL_PROBE_FIELD(DeviceMaterial, specular) RTCL_PROBE_FIELD(DeviceMaterial, emission)
 RTCL_PROBE_FIELD(DeviceMaterial, kr) RTCL_PROBE_FIELD(DeviceMaterial, kt)
 RTCL_PROBE_FIELD(DeviceMaterial, kt[2]) RTCL_PROBE_FIELD(DeviceMaterial, shininess)
-RTCL_PROBE_FIELD(DeviceMaterial, ior)
+RTCL_PROBE_FIELD(DeviceMaterial, ior) RTCL_PROBE_FIELD(DeviceMaterial, roughness)
 
 RTCL_PROBE_RECORD(DeviceLight)
 RTCL_PROBE_FIELD(DeviceLight, position) RTCL_PROBE_FIELD(DeviceLight, radiance)
+RTCL_PROBE_FIELD(DeviceLight, u) RTCL_PROBE_FIELD(DeviceLight, v) RTCL_PROBE_FIELD(DeviceLight, radius)
+RTCL_PROBE_FIELD(DeviceLight, shape)
 
 RTCL_PROBE_RECORD(DeviceCamera)
 RTCL_PROBE_FIELD(DeviceCamera, origin) RTCL_PROBE_FIELD(DeviceCamera, corner)
 RTCL_PROBE_FIELD(DeviceCamera, du) RTCL_PROBE_FIELD(DeviceCamera, dv)
 RTCL_PROBE_FIELD(DeviceCamera, width) RTCL_PROBE_FIELD(DeviceCamera, height)
+RTCL_PROBE_FIELD(DeviceCamera, lens_u) RTCL_PROBE_FIELD(DeviceCamera, lens_v)
+RTCL_PROBE_FIELD(DeviceCamera, focus_distance) RTCL_PROBE_FIELD(DeviceCamera, sampler)
+RTCL_PROBE_FIELD(DeviceCamera, seed) RTCL_PROBE_FIELD(DeviceCamera, filter)
 
 RTCL_PROBE_RECORD(ShadeParams)
 RTCL_PROBE_FIELD(ShadeParams, ambient) RTCL_PROBE_FIELD(ShadeParams, background)
 RTCL_PROBE_FIELD(ShadeParams, min_weight) RTCL_PROBE_FIELD(ShadeParams, max_depth)
-RTCL_PROBE_FIELD(ShadeParams, triangle_count) RTCL_PROBE_FIELD(ShadeParams, pad)
+RTCL_PROBE_FIELD(ShadeParams, triangle_count) RTCL_PROBE_FIELD(ShadeParams, sampler)
+RTCL_PROBE_FIELD(ShadeParams, seed) RTCL_PROBE_FIELD(ShadeParams, spp)
+RTCL_PROBE_FIELD(ShadeParams, light_samples) RTCL_PROBE_FIELD(ShadeParams, shadow_slots)
 
 RTCL_PROBE_RECORD(ShadeTriangle)
 RTCL_PROBE_FIELD(ShadeTriangle, v) RTCL_PROBE_FIELD(ShadeTriangle, v[2][1])
@@ -122,6 +129,16 @@ RTCL_PROBE_VALUE(RTCL_SCAN_CHUNK)
 RTCL_PROBE_VALUE(RTCL_TILE)
 RTCL_PROBE_VALUE(rtcl_tile_order_pixel(77u, 13u, 11u))
 RTCL_PROBE_VALUE(rtcl_hash(12345u))
+RTCL_PROBE_VALUE(RTCL_LIGHT_POINT) RTCL_PROBE_VALUE(RTCL_LIGHT_QUAD) RTCL_PROBE_VALUE(RTCL_LIGHT_DISC)
+RTCL_PROBE_VALUE(RTCL_LIGHT_SPHERE) RTCL_PROBE_VALUE(RTCL_LIGHT_TRIANGLE)
+RTCL_PROBE_VALUE(RTCL_SAMPLER_STRATIFIED) RTCL_PROBE_VALUE(RTCL_SAMPLER_RANDOM) RTCL_PROBE_VALUE(RTCL_SAMPLER_SOBOL)
+RTCL_PROBE_VALUE(RTCL_FILTER_BOX) RTCL_PROBE_VALUE(RTCL_FILTER_GAUSSIAN)
+RTCL_PROBE_VALUE(rtcl_dimension_light(3u, 2u, 1u)) RTCL_PROBE_VALUE(rtcl_dimension_glossy(3u, 2u))
+RTCL_PROBE_VALUE(rtcl_owen_scramble(0x9e3779b9u, 77u)) RTCL_PROBE_VALUE(rtcl_sobol_second(12345u))
+RTCL_PROBE_VALUE(rtcl_reverse_bits(12345u)) RTCL_PROBE_VALUE(rtcl_permute(5u, 11u, 99u))
+RTCL_PROBE_VALUE(rtcl_mix_bits(5u, 4u, 99u)) RTCL_PROBE_VALUE(rtcl_sample_key(1u, 2u, 3u, 4u))
+RTCL_PROBE_VALUE(rtcl_ceil_sqrt(2147395600u)) RTCL_PROBE_VALUE(rtcl_ceil_sqrt(2147395601u))
+RTCL_PROBE_VALUE(rtcl_ceil_sqrt(1u)) RTCL_PROBE_VALUE(rtcl_ceil_sqrt(24u))
 
 RTCL_PROBE_RECORD(SlabVolume)
 RTCL_PROBE_FIELD(SlabVolume, normal) RTCL_PROBE_FIELD(SlabVolume, normal[12][3])

@@ -6,6 +6,7 @@
  * Hit field by field, proving that both sides address the same bytes. */
 #include "shared/layouts.h"
 #include "shared/render_layouts.h"
+#include "shared/sampling.h"
 #include "shared/bounds_layouts.h"
 
 /* Byte offsets inside a private record: layout does not depend on the

@@ -1,29 +1,47 @@
 /* Camera rays of the wavefront renderer: one per pixel of a batch, in
  * screen-tile order (rtcl_tile_order_pixel), so that consecutive work-items
- * and packets of 8 trace coherent rays. */
+ * and packets of 8 trace coherent rays.
+ *
+ * Specialised by -D: RTCL_HAS_LENS (a thin-lens camera, aperture > 0). */
 #include "shared/layouts.h"
 #include "shared/render_layouts.h"
+#include "shared/sampling.h"
 
-/* Rays first .. first+count-1 of the tile order, for sample `sample` of `spp`
- * (rtcl_sample_position). Directions are unit length; tmin = 0, tmax = inf.
- * Paths start at depth 0 with weight 1. */
+inline float3 cam3(const float* a) { return (float3)(a[0], a[1], a[2]); }
+
+/* Rays first .. first+count-1 of the tile order, for sample `sample` of `spp`:
+ * the sub-pixel position is the sampler's point in dimension RTCL_DIM_PIXEL
+ * warped by the filter (shared/sampling.h); with a lens, the origin is the
+ * sampler's point in RTCL_DIM_LENS on the aperture disc (concentric map) and
+ * the ray passes through the pinhole ray's point at the focus distance.
+ * Directions are unit length; tmin = 0, tmax = inf. Paths start at depth 0
+ * with weight 1. */
 kernel void generate_camera_rays(global Ray* rays, global PathState* paths, global const DeviceCamera* camera,
                                  uint first, uint count, uint sample, uint spp) {
   uint i = get_global_id(0);
   if (i >= count) return;
   DeviceCamera c = *camera;
   uint pixel = rtcl_tile_order_pixel(first + i, c.width, c.height);
-  float jx, jy;
-  rtcl_sample_position(pixel, sample, spp, &jx, &jy);
-  float fx = (float)(pixel % c.width) + jx;
-  float fy = (float)(pixel / c.width) + jy;
-  float3 d = (float3)(c.corner[0], c.corner[1], c.corner[2]) + fx * (float3)(c.du[0], c.du[1], c.du[2]) +
-             fy * (float3)(c.dv[0], c.dv[1], c.dv[2]);
+  float su, sv, dx, dy;
+  rtcl_sample_2d(c.sampler, c.seed, pixel, RTCL_DIM_PIXEL, sample, spp, &su, &sv);
+  rtcl_filter_offset(c.filter, su, sv, &dx, &dy);
+  float fx = (float)(pixel % c.width) + 0.5f + dx;
+  float fy = (float)(pixel / c.width) + 0.5f + dy;
+  float3 o = cam3(c.origin);
+  float3 d = cam3(c.corner) + fx * cam3(c.du) + fy * cam3(c.dv);
+#ifdef RTCL_HAS_LENS
+  float lu, lv, a, b;
+  rtcl_sample_2d(c.sampler, c.seed, pixel, RTCL_DIM_LENS, sample, spp, &lu, &lv);
+  rtcl_concentric_disc(lu, lv, &a, &b);
+  float3 lens = a * cam3(c.lens_u) + b * cam3(c.lens_v);
+  d = c.focus_distance * d - lens; /* (origin + focus * d) - (origin + lens) */
+  o += lens;
+#endif
   d = normalize(d);
   Ray r;
-  r.ox = c.origin[0];
-  r.oy = c.origin[1];
-  r.oz = c.origin[2];
+  r.ox = o.x;
+  r.oy = o.y;
+  r.oz = o.z;
   r.dx = d.x;
   r.dy = d.y;
   r.dz = d.z;

@@ -5,11 +5,20 @@
  * IntersectColor becomes the next queue; the lecture's `else if` between
  * reflection and refraction becomes both rays, weighted by Fresnel.
  *
+ * Distributed effects (Cook, Porter and Carpenter 1984): an area light is
+ * sampled at P.light_samples points per shading point (stratified over the
+ * pixel's samples by the sampler), each a point light of radiance / samples;
+ * a rough material's reflected ray is drawn from a Phong lobe around the
+ * mirror direction. Sample dimensions and indices: shared/sampling.h.
+ *
  * Specialised by -D: RTCL_LIGHT_COUNT=n, RTCL_HAS_SPHERES,
  * RTCL_HAS_REFLECTION (some material has kr > 0 or kt > 0),
- * RTCL_HAS_REFRACTION (some material has kt > 0). */
+ * RTCL_HAS_REFRACTION (some material has kt > 0), RTCL_HAS_AREA_LIGHTS (a
+ * quad, disc or sphere light), RTCL_HAS_GLOSSY (a reflecting material with
+ * roughness > 0). */
 #include "shared/layouts.h"
 #include "shared/render_layouts.h"
+#include "shared/sampling.h"
 
 #ifndef RTCL_LIGHT_COUNT
 #define RTCL_LIGHT_COUNT 0
@@ -46,6 +55,16 @@
 inline float3 load3(const float* a) { return (float3)(a[0], a[1], a[2]); }
 inline float3 load3g(global const float* a) { return (float3)(a[0], a[1], a[2]); }
 inline float max3(float3 v) { return fmax(v.x, fmax(v.y, v.z)); }
+
+/* Two unit vectors completing the unit vector n to an orthonormal basis
+ * (Duff et al., JCGT 2017; the host twin: src/rtcl/scene/orthonormal_basis.hpp). */
+inline void orthonormal_basis(float3 n, float3* t1, float3* t2) {
+  float sign = copysign(1.0f, n.z);
+  float a = -1.0f / (sign + n.z);
+  float b = n.x * n.y * a;
+  *t1 = (float3)(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  *t2 = (float3)(b, sign + n.y * n.y * a, -n.y);
+}
 
 typedef struct SurfacePoint {
   float3 p;       /* hit point, rebuilt from the primitive */
@@ -115,23 +134,55 @@ inline float fresnel_dielectric(float cos_i, float cos_t, float eta) {
   return 0.5f * (rs * rs + rp * rp);
 }
 
-/* Per queued ray i (< count), with its closest hit:
+#ifdef RTCL_HAS_AREA_LIGHTS
+/* Point of light `l` for the shading point p at (u, v) in [0, 1)^2: a quad
+ * uniformly by area, a triangle by folding the unit square's upper half onto
+ * the lower (uniform by area), a disc by the concentric map, a sphere on the
+ * disc through its centre facing p. */
+inline float3 light_point(global const DeviceLight* l, float3 p, float u, float v) {
+  float3 c = load3g(l->position);
+  if (l->shape == RTCL_LIGHT_QUAD) return c + u * load3g(l->u) + v * load3g(l->v);
+  if (l->shape == RTCL_LIGHT_TRIANGLE) {
+    if (u + v > 1.0f) {
+      u = 1.0f - u;
+      v = 1.0f - v;
+    }
+    return c + u * load3g(l->u) + v * load3g(l->v);
+  }
+  float x, y;
+  rtcl_concentric_disc(u, v, &x, &y);
+  if (l->shape == RTCL_LIGHT_DISC) return c + x * load3g(l->u) + y * load3g(l->v);
+  if (l->shape == RTCL_LIGHT_SPHERE) {
+    float3 w = c - p;
+    float len = length(w);
+    if (!(len > 0.0f)) return c;
+    float3 t1, t2;
+    orthonormal_basis(w / len, &t1, &t2);
+    return c + l->radius * (x * t1 + y * t2);
+  }
+  return c;
+}
+#endif
+
+/* Per queued ray i (< count) of pixel sample `sample`, with its closest hit:
  *  radiance[i]            weight * (emission + ambient) at the hit, or weight * background on a miss;
- *  shadow slots i*L + l   a shadow ray towards light l and its unoccluded contribution (flag 1), or flag 0;
+ *  shadow slots i*S + k   (S = P.shadow_slots) a shadow ray towards a light point and its unoccluded
+ *                         contribution (flag 1), or flag 0; point lights take one slot, area lights
+ *                         P.light_samples, in light order;
  *  spawn slots 2i, 2i+1   the reflected / refracted ray and path (flag = kind), or flag 0. */
 kernel void shade_hits(global const Ray* rays, global const Hit* hits, global const PathState* paths, uint count,
                        global const ShadeTriangle* triangles, global const ShadeSphere* spheres,
                        global const DeviceMaterial* materials, global const DeviceLight* lights,
                        global const ShadeParams* params, global float4* radiance, global Ray* shadow_rays,
                        global float4* shadow_weight, global uint* shadow_flags, global Ray* spawn_rays,
-                       global PathState* spawn_paths, global uint* spawn_flags) {
+                       global PathState* spawn_paths, global uint* spawn_flags, uint sample) {
   uint i = get_global_id(0);
   if (i >= count) return;
-  for (uint l = 0; l < RTCL_LIGHT_COUNT; ++l) shadow_flags[i * RTCL_LIGHT_COUNT + l] = RTCL_SLOT_EMPTY;
+  ShadeParams P = *params;
+  for (uint k = 0; k < P.shadow_slots; ++k) shadow_flags[i * P.shadow_slots + k] = RTCL_SLOT_EMPTY;
   spawn_flags[2 * i] = RTCL_SLOT_EMPTY;
   spawn_flags[2 * i + 1] = RTCL_SLOT_EMPTY;
 
-  ShadeParams P = *params;
   PathState path = paths[i];
   float3 w = (float3)(path.wr, path.wg, path.wb);
   Hit h = hits[i];
@@ -152,23 +203,41 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
 
 #if RTCL_LIGHT_COUNT > 0
   float3 kd = load3g(m->diffuse), ks = load3g(m->specular);
+  uint slot = i * P.shadow_slots;
   for (uint l = 0; l < RTCL_LIGHT_COUNT; ++l) {
-    float3 light_position = load3g(lights[l].position);
-    float3 ld = normalize(light_position - s.p); /* shading from the hit point, not the offset origin */
-    float cos_l = dot(n, ld);
-    if (!(cos_l > 0.0f)) continue;
-    float3 f = kd * cos_l;
-    if (max3(ks) > 0.0f) {
-      float3 mirror = 2.0f * cos_l * n - ld;
-      float rv = fmax(dot(mirror, -d), 0.0f);
-      f += ks * (m->shininess > 0.0f ? pow(rv, m->shininess) : 1.0f);
+    uint points = 1;
+    float share = 1.0f;
+#ifdef RTCL_HAS_AREA_LIGHTS
+    uint dimension = rtcl_dimension_light(path.depth, RTCL_LIGHT_COUNT, l);
+    if (lights[l].shape != RTCL_LIGHT_POINT) {
+      points = P.light_samples;
+      share = 1.0f / (float)points;
     }
-    float3 c = w * load3g(lights[l].radiance) * f;
-    if (!(max3(c) > 0.0f)) continue;
-    uint slot = i * RTCL_LIGHT_COUNT + l;
-    shadow_rays[slot] = make_ray(above, light_position - above, 1.0f - RTCL_SHADOW_SHORTEN);
-    shadow_weight[slot] = (float4)(c, 0.0f);
-    shadow_flags[slot] = RTCL_SLOT_SHADOW;
+#endif
+    for (uint j = 0; j < points; ++j, ++slot) {
+      float3 light_position = load3g(lights[l].position);
+#ifdef RTCL_HAS_AREA_LIGHTS
+      if (lights[l].shape != RTCL_LIGHT_POINT) {
+        float u, v;
+        rtcl_sample_2d(P.sampler, P.seed, path.pixel, dimension, sample * points + j, P.spp * points, &u, &v);
+        light_position = light_point(lights + l, s.p, u, v);
+      }
+#endif
+      float3 ld = normalize(light_position - s.p); /* shading from the hit point, not the offset origin */
+      float cos_l = dot(n, ld);
+      if (!(cos_l > 0.0f)) continue;
+      float3 f = kd * cos_l;
+      if (max3(ks) > 0.0f) {
+        float3 mirror = 2.0f * cos_l * n - ld;
+        float rv = fmax(dot(mirror, -d), 0.0f);
+        f += ks * (m->shininess > 0.0f ? pow(rv, m->shininess) : 1.0f);
+      }
+      float3 c = w * load3g(lights[l].radiance) * f * share;
+      if (!(max3(c) > 0.0f)) continue;
+      shadow_rays[slot] = make_ray(above, light_position - above, 1.0f - RTCL_SHADOW_SHORTEN);
+      shadow_weight[slot] = (float4)(c, 0.0f);
+      shadow_flags[slot] = RTCL_SLOT_SHADOW;
+    }
   }
 #endif
 
@@ -194,9 +263,23 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
     wr += w * kt * F;
   }
 #endif
-  if (max3(wr) > 0.0f && max3(wr) >= P.min_weight)
-    spawn(spawn_rays, spawn_paths, spawn_flags, 2 * i, above, d + 2.0f * cos_i * n, wr, path.depth + 1, path.pixel,
+  if (max3(wr) > 0.0f && max3(wr) >= P.min_weight) {
+    float3 rd = d + 2.0f * cos_i * n;
+#ifdef RTCL_HAS_GLOSSY
+    if (m->roughness > 0.0f) {
+      float u, v, cos_a, sin_a, cos_phi, sin_phi;
+      rtcl_sample_2d(P.sampler, P.seed, path.pixel, rtcl_dimension_glossy(path.depth, RTCL_LIGHT_COUNT), sample,
+                     P.spp, &u, &v);
+      rtcl_phong_lobe(rtcl_roughness_exponent(m->roughness), u, v, &cos_a, &sin_a, &cos_phi, &sin_phi);
+      float3 axis = normalize(rd), t1, t2;
+      orthonormal_basis(axis, &t1, &t2);
+      rd = cos_a * axis + sin_a * (cos_phi * t1 + sin_phi * t2);
+      if (!(dot(rd, n) > 0.0f)) return; /* below the surface: the lobe's share there is lost */
+    }
+#endif
+    spawn(spawn_rays, spawn_paths, spawn_flags, 2 * i, above, rd, wr, path.depth + 1, path.pixel,
           RTCL_SLOT_REFLECTION);
+  }
 #endif
 }
 
@@ -208,7 +291,7 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
 kernel void accumulate_radiance(global const PathState* paths, uint count, global const float4* radiance,
                                 global const float4* shadow_weight, global const uint* shadow_flags,
                                 global const uint* shadow_index, global const Hit* shadow_hits,
-                                global float4* framebuffer) {
+                                global float4* framebuffer, uint shadow_slots) {
   uint i = get_global_id(0);
   if (i >= count) return;
   uint pixel = paths[i].pixel;
@@ -216,8 +299,8 @@ kernel void accumulate_radiance(global const PathState* paths, uint count, globa
   float4 sum = (float4)(0.0f);
   for (uint j = i; j < count && paths[j].pixel == pixel; ++j) {
     sum += radiance[j];
-    for (uint l = 0; l < RTCL_LIGHT_COUNT; ++l) {
-      uint slot = j * RTCL_LIGHT_COUNT + l;
+    for (uint k = 0; k < shadow_slots; ++k) {
+      uint slot = j * shadow_slots + k;
       if (shadow_flags[slot] != RTCL_SLOT_EMPTY && shadow_hits[shadow_index[slot]].prim < 0)
         sum += shadow_weight[slot];
     }

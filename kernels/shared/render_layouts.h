@@ -1,5 +1,6 @@
 /* Records of the wavefront renderer that cross the host/device boundary, and
- * the integer conventions (screen-tile order, sample jitter) the host
+ * the integer conventions (screen-tile order, the hash behind the samplers
+ * of shared/sampling.h) the host
  * reference renderer must reproduce bit for bit. Same rules as layouts.h:
  * every field a 4-byte scalar, no float3, host static_asserts in
  * src/rtcl/render/render_layouts.cpp. Include shared/layouts.h first. */
@@ -17,7 +18,7 @@ typedef struct PathState {
   float wr, wg, wb;   /* path weight (product of kr/kt factors), linear RGB */
 } PathState;
 
-/* Phong material with Whitted reflection and refraction: 80 bytes. Colours
+/* Phong material with Whitted reflection and refraction: 84 bytes. Colours
  * are linear RGB. Reflected rays carry kr + kt * F, refracted rays kt * (1 - F)
  * (F: exact dielectric Fresnel reflectance; 1 under total internal
  * reflection). */
@@ -26,34 +27,60 @@ typedef struct DeviceMaterial {
   float kr[3], kt[3];
   float shininess; /* Phong exponent */
   float ior;       /* index of refraction inside the surface (outside: 1) */
+  float roughness; /* 0: mirror reflection; in (0, 1]: the reflected ray is drawn from a Phong lobe */
 } DeviceMaterial;
 
-/* A point light: 24 bytes. radiance = colour * intensity, not attenuated
- * with distance (classic Whitted point light). */
+/* Light shapes (DeviceLight.shape). */
+#define RTCL_LIGHT_POINT 0u
+#define RTCL_LIGHT_QUAD 1u
+#define RTCL_LIGHT_DISC 2u
+#define RTCL_LIGHT_SPHERE 3u
+#define RTCL_LIGHT_TRIANGLE 4u
+
+/* A light: 56 bytes. radiance = colour * intensity, not attenuated with
+ * distance (classic Whitted light). An area light is the average of point
+ * lights of that radiance over its points (uniform by area; a sphere by the
+ * disc through its centre facing the shaded point), so a light of size zero
+ * is the point light. */
 typedef struct DeviceLight {
-  float position[3];
+  float position[3]; /* point: the point; quad, triangle: a corner; disc, sphere: the centre */
   float radiance[3];
+  float u[3], v[3];  /* quad, triangle: two edges from the corner; disc: two orthogonal radius vectors; else 0 */
+  float radius;      /* sphere: its radius; else 0 */
+  rtcl_u32 shape;    /* RTCL_LIGHT_* */
 } DeviceLight;
 
-/* Pinhole camera for one image: the direction of the ray through image
- * position (x, y) (pixels, y down, (0, 0) the top-left corner of the top-left
- * pixel) is corner + x * du + y * dv (not normalised). 56 bytes. */
+/* Camera for one image: the pinhole direction through image position (x, y)
+ * (pixels, y down, (0, 0) the top-left corner of the top-left pixel) is
+ * corner + x * du + y * dv (not normalised; its component along the view
+ * direction is 1). A thin lens (kernels/render/generate.cl) moves the origin
+ * to origin + a * lens_u + b * lens_v, (a, b) in the unit disc, and aims at
+ * origin + focus_distance * (pinhole direction). 96 bytes. */
 typedef struct DeviceCamera {
   float origin[3];
   float corner[3];
   float du[3];
   float dv[3];
   rtcl_u32 width, height;
+  float lens_u[3], lens_v[3]; /* aperture radius times the image's right and up unit vectors */
+  float focus_distance;       /* along the view direction, scene units */
+  rtcl_u32 sampler;           /* RTCL_SAMPLER_* (shared/sampling.h) */
+  rtcl_u32 seed;
+  rtcl_u32 filter; /* RTCL_FILTER_* */
 } DeviceCamera;
 
-/* Constants of the shade kernel: 40 bytes. */
+/* Constants of the shade kernel: 56 bytes. */
 typedef struct ShadeParams {
   float ambient[3];    /* ambient light, multiplies each material's ambient */
   float background[3]; /* radiance of rays that hit nothing */
   float min_weight;    /* a spawned ray whose weight's largest component is below this is dropped */
   rtcl_u32 max_depth;  /* bounces allowed after the camera ray's hit */
   rtcl_u32 triangle_count; /* prim ids below it are triangles, the rest spheres */
-  rtcl_u32 pad;
+  rtcl_u32 sampler;        /* RTCL_SAMPLER_* */
+  rtcl_u32 seed;
+  rtcl_u32 spp;            /* samples per pixel */
+  rtcl_u32 light_samples;  /* shadow rays per area light and shading point */
+  rtcl_u32 shadow_slots;   /* shadow slots per shaded ray: 1 per point light, light_samples per area light */
 } ShadeParams;
 
 /* A triangle as the shade kernel sees it (vertices, for the geometric normal
@@ -123,27 +150,6 @@ inline rtcl_u32 rtcl_hash(rtcl_u32 x) {
   x *= 0x846ca68bu;
   x ^= x >> 16;
   return x;
-}
-
-/* Position inside its pixel of sample `sample` of `spp` (both in [0, 1)):
- * the centre for one sample; otherwise jittered stratified sampling on a
- * k x k grid, k = ceil(sqrt(spp)), one random point in stratum `sample`.
- * Exact in float: both sides compute the same values. */
-inline void rtcl_sample_position(rtcl_u32 pixel, rtcl_u32 sample, rtcl_u32 spp, float* jx, float* jy) {
-  if (spp <= 1u) {
-    *jx = 0.5f;
-    *jy = 0.5f;
-    return;
-  }
-  rtcl_u32 k = 1u;
-  while (k * k < spp) ++k;
-  rtcl_u32 h1 = rtcl_hash(pixel * 0x9e3779b9u ^ rtcl_hash(sample));
-  rtcl_u32 h2 = rtcl_hash(h1 ^ 0x68bc21ebu);
-  float u = (float)(h1 >> 8) * (1.0f / 16777216.0f);
-  float v = (float)(h2 >> 8) * (1.0f / 16777216.0f);
-  float inv_k = 1.0f / (float)k;
-  *jx = ((float)(sample % k) + u) * inv_k;
-  *jy = ((float)((sample / k) % k) + v) * inv_k;
 }
 
 #ifndef __OPENCL_VERSION__

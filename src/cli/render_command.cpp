@@ -15,6 +15,7 @@
 #include "rtcl/render/camera.hpp"
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/renderer.hpp"
+#include "rtcl/render/sampling_options.hpp"
 #include "rtcl/scene/default_scene.hpp"
 #include "rtcl/scene/scene_file.hpp"
 
@@ -32,6 +33,8 @@ struct Options {
   std::uint32_t depth = 5, spp = 1;
   float min_weight = 1e-3f;
   std::uint32_t batch = 1u << 17;
+  std::string sampler = "stratified", filter = "box";
+  std::uint32_t seed = 0, light_samples = 1;
   bool quiet = false;
   bool verbose = false;
 };
@@ -83,6 +86,10 @@ void run(const Options& o) {
   settings.spp = o.spp;
   settings.min_weight = o.min_weight;
   settings.batch_pixels = o.batch;
+  settings.sampler = *sampler_from_name(o.sampler);  // checked by the option's validator
+  settings.filter = *filter_from_name(o.filter);
+  settings.seed = o.seed;
+  settings.light_samples = o.light_samples;
 
   AccelConfig config;
   config.precision = !o.precision.empty() ? parse_precision(o.precision) : scene.precision.value_or(Precision::robust);
@@ -97,10 +104,11 @@ void run(const Options& o) {
 
   const RenderStats& st = renderer.stats();
   const RayCounts& r = st.rays;
-  std::printf("rtcl render: %s (%ux%u, %u spp, depth %u, %s, %s precision, %s): %llu camera + %llu shadow + %llu reflection + "
+  std::printf("rtcl render: %s (%ux%u, %u spp %s seed %u, %s filter, %u light samples, depth %u, %s, %s precision, %s): %llu camera + %llu shadow + %llu reflection + "
               "%llu refraction = %llu rays in %.3f s, %.2f Mrays/s (trace only: camera %.2f, shadow %.2f, "
               "secondary %.2f Mrays/s)\n",
-              o.output.c_str(), settings.width, settings.height, settings.spp, settings.max_depth, accel.c_str(),
+              o.output.c_str(), settings.width, settings.height, settings.spp, o.sampler.c_str(), settings.seed,
+              o.filter.c_str(), settings.light_samples, settings.max_depth, accel.c_str(),
               std::string(precision_name(config.precision)).c_str(), device.info().name.c_str(), (unsigned long long)r.camera, (unsigned long long)r.shadow,
               (unsigned long long)r.reflection, (unsigned long long)r.refraction, (unsigned long long)r.total(),
               st.render_ms * 1e-3, mrays(r.total(), st.render_ms), mrays(r.camera, st.camera_trace_ms),
@@ -119,8 +127,9 @@ void run(const Options& o) {
 void add_render_command(CLI::App& app) {
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand(
-      "render", "Whitted ray tracing (reflection, refraction, hard shadows) of a scene file, or of the built-in "
-                "default scene when none is given");
+      "render", "Whitted and distributed ray tracing (reflection, refraction, hard and soft shadows, "
+                "anti-aliasing, depth of field, glossy reflection) of a scene file, or of the built-in default scene "
+                "when none is given");
   cmd->add_option("scene", o->scene, "Scene file (JSON, see README); none: the built-in default scene");
   cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
                                             ".exr: linear float)")
@@ -136,9 +145,35 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--depth", o->depth, "Reflection/refraction bounces after the first hit (speed/accuracy)")
       ->capture_default_str()
       ->check(CLI::Range(0, 64));
-  cmd->add_option("--spp", o->spp, "Jittered samples per pixel (anti-aliasing)")
+  cmd->add_option("--spp", o->spp, "Samples per pixel (anti-aliasing; each carries its own lens, light and glossy "
+                                    "samples) (speed/accuracy)")
       ->capture_default_str()
       ->check(CLI::Range(1, 65536));
+  cmd->add_option("--sampler", o->sampler,
+                  "Sample pattern: " + sampler_names() +
+                      " (stratified: jittered strata, one sample = the pixel centre; random: independent; sobol: "
+                      "Owen-scrambled Sobol)")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](const std::string& name) {
+            return sampler_from_name(name) ? std::string()
+                                           : "unknown sampler '" + name + "' (known: " + sampler_names() + ")";
+          },
+          "NAME", "sampler"));
+  cmd->add_option("--seed", o->seed, "Seed of every sample pattern (the image is a function of it)")
+      ->capture_default_str();
+  cmd->add_option("--filter", o->filter, "Reconstruction filter: " + filter_names() + " (gaussian: sigma 0.5 px, radius 1.5 px)")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](const std::string& name) {
+            return filter_from_name(name) ? std::string()
+                                          : "unknown filter '" + name + "' (known: " + filter_names() + ")";
+          },
+          "NAME", "filter"));
+  cmd->add_option("--light-samples", o->light_samples,
+                  "Shadow rays per area light and shading point (soft shadows; speed/accuracy)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 4096));
   cmd->add_option("--min-weight", o->min_weight,
                   "Drop secondary rays whose path weight is below this (speed/accuracy; 0 keeps all)")
       ->capture_default_str()

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 
 #include "rtcl/render/camera.hpp"
 #include "rtcl/render/render_layouts.hpp"
+#include "rtcl/scene/orthonormal_basis.hpp"
 
 namespace rtcl::test {
 
@@ -35,6 +37,7 @@ class Tracer {
   Tracer(const Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {
     FlatScene flat = flatten(scene);
     material_ = flat.material;
+    lights_ = expand_emissive_lights(scene, flat);
     const Geometry& g = flat.geometry;
     for (std::size_t t = 0; t < g.triangles.size(); ++t) {
       Tri tri;
@@ -45,9 +48,47 @@ class Tracer {
     for (const Sphere& s : g.spheres) spheres_.push_back({dvec3(s.center), double(s.radius)});
   }
 
+  // The sample being traced: the sampler's points come from (pixel, sample).
+  struct SampleId {
+    std::uint32_t pixel = 0, sample = 0;
+  };
+
+  void sample_2d(const SampleId& id, std::uint32_t dimension, std::uint32_t index, std::uint32_t count, double& u,
+                 double& v) const {
+    float fu, fv;
+    rtcl_sample_2d(static_cast<std::uint32_t>(settings_.sampler), settings_.seed, id.pixel, dimension, index, count,
+                   &fu, &fv);
+    u = fu;
+    v = fv;
+  }
+
+  // A point of light l for the shading point p at (u, v) (the rules of
+  // light_point in kernels/render/shade.cl), in double.
+  static dvec3 light_point(const Light& l, const dvec3& p, double u, double v) {
+    dvec3 c(l.position);
+    if (l.shape == LightShape::point) return c;
+    if (l.shape == LightShape::quad)
+      return c - 0.5 * (dvec3(l.edge1) + dvec3(l.edge2)) + u * dvec3(l.edge1) + v * dvec3(l.edge2);
+    if (l.shape == LightShape::triangle) {
+      if (u + v > 1.0) {  // the kernel's fold, on the same float sample values
+        u = 1.0 - u;
+        v = 1.0 - v;
+      }
+      return c + u * dvec3(l.edge1) + v * dvec3(l.edge2);
+    }
+    float fx, fy;
+    rtcl_concentric_disc(static_cast<float>(u), static_cast<float>(v), &fx, &fy);
+    double x = fx, y = fy;
+    dvec3 n = l.shape == LightShape::disc ? glm::normalize(dvec3(l.normal)) : glm::normalize(c - p);
+    dvec3 t1, t2;
+    orthonormal_basis(n, t1, t2);
+    return c + double(l.radius) * (x * t1 + y * t2);
+  }
+
   // Radiance along the unit direction d from o; `signature` mixes in every
   // decision the ray tree makes.
-  dvec3 trace(const dvec3& o, const dvec3& d, const dvec3& w, std::uint32_t depth, std::uint64_t& signature) const {
+  dvec3 trace(const dvec3& o, const dvec3& d, const dvec3& w, std::uint32_t depth, const SampleId& id,
+              std::uint64_t& signature) const {
     RefHit h = closest(o, d, std::numeric_limits<double>::infinity(), false);
     mix(signature, static_cast<std::uint64_t>(h.prim + 1));
     if (h.prim < 0) return w * dvec3(scene_.background);
@@ -76,21 +117,31 @@ class Tracer {
     dvec3 above = p + offset * n;
     dvec3 radiance = w * (dvec3(m.emission) + dvec3(scene_.ambient) * dvec3(m.ambient));
 
-    for (const PointLight& light : scene_.lights) {
-      dvec3 ld = glm::normalize(dvec3(light.position) - p);
-      double cos_l = glm::dot(n, ld);
-      if (!(cos_l > 0.0)) continue;
-      dvec3 f = dvec3(m.diffuse) * cos_l;
-      if (max3(dvec3(m.specular)) > 0.0) {
-        dvec3 mirror = 2.0 * cos_l * n - ld;
-        double rv = std::max(glm::dot(mirror, -d), 0.0);
-        f += dvec3(m.specular) * (m.shininess > 0.0f ? std::pow(rv, double(m.shininess)) : 1.0);
+    const auto light_count = static_cast<std::uint32_t>(lights_.size());
+    for (std::uint32_t l = 0; l < light_count; ++l) {
+      const Light& light = lights_[l];
+      std::uint32_t points = light.area() ? settings_.light_samples : 1u;
+      for (std::uint32_t j = 0; j < points; ++j) {
+        double u = 0.0, v = 0.0;
+        if (light.area())
+          sample_2d(id, rtcl_dimension_light(depth, light_count, l), id.sample * points + j, settings_.spp * points, u,
+                    v);
+        dvec3 q = light_point(light, p, u, v);
+        dvec3 ld = glm::normalize(q - p);
+        double cos_l = glm::dot(n, ld);
+        if (!(cos_l > 0.0)) continue;
+        dvec3 f = dvec3(m.diffuse) * cos_l;
+        if (max3(dvec3(m.specular)) > 0.0) {
+          dvec3 mirror = 2.0 * cos_l * n - ld;
+          double rv = std::max(glm::dot(mirror, -d), 0.0);
+          f += dvec3(m.specular) * (m.shininess > 0.0f ? std::pow(rv, double(m.shininess)) : 1.0);
+        }
+        dvec3 c = w * dvec3(light.color) * double(light.intensity) * f / double(points);
+        if (!(max3(c) > 0.0)) continue;
+        bool occluded = closest(above, q - above, 1.0 - shadow_shorten, true).prim >= 0;
+        mix(signature, occluded ? 0x51u : 0x52u);
+        if (!occluded) radiance += c;
       }
-      dvec3 c = w * dvec3(light.color) * double(light.intensity) * f;
-      if (!(max3(c) > 0.0)) continue;
-      bool occluded = closest(above, dvec3(light.position) - above, 1.0 - shadow_shorten, true).prim >= 0;
-      mix(signature, occluded ? 0x51u : 0x52u);
-      if (!occluded) radiance += c;
     }
 
     if (depth >= settings_.max_depth || (!m.reflective() && !m.transmissive())) return radiance;
@@ -108,12 +159,27 @@ class Tracer {
         dvec3 wt = w * dvec3(m.kt) * (1.0 - F);
         if (max3(wt) > 0.0 && max3(wt) >= min_weight) {
           dvec3 td = glm::normalize(eta * d + (eta * cos_i - cos_t) * n);
-          radiance += trace(p - offset * n, td, wt, depth + 1, signature);
+          radiance += trace(p - offset * n, td, wt, depth + 1, id, signature);
         }
       }
       wr += w * dvec3(m.kt) * F;
     }
-    if (max3(wr) > 0.0 && max3(wr) >= min_weight) radiance += trace(above, d + 2.0 * cos_i * n, wr, depth + 1, signature);
+    if (!(max3(wr) > 0.0 && max3(wr) >= min_weight)) return radiance;
+    dvec3 rd = glm::normalize(d + 2.0 * cos_i * n);
+    if (m.roughness > 0.0f) {  // a direction of the Phong lobe around the mirror direction
+      double u, v;
+      sample_2d(id, rtcl_dimension_glossy(depth, light_count), id.sample, settings_.spp, u, v);
+      double exponent = 2.0 / (double(m.roughness) * m.roughness) - 2.0;
+      double cos_a = std::pow(1.0 - u, 1.0 / (exponent + 1.0));
+      double sin_a = std::sqrt(std::max(0.0, 1.0 - cos_a * cos_a));
+      double phi = 2.0 * std::numbers::pi * v;
+      dvec3 t1, t2;
+      orthonormal_basis(rd, t1, t2);
+      rd = cos_a * rd + sin_a * (std::cos(phi) * t1 + std::sin(phi) * t2);
+      mix(signature, glm::dot(rd, n) > 0.0 ? 0x61u : 0x62u);
+      if (!(glm::dot(rd, n) > 0.0)) return radiance;
+    }
+    radiance += trace(above, rd, wr, depth + 1, id, signature);
     return radiance;
   }
 
@@ -179,6 +245,7 @@ class Tracer {
   const Scene& scene_;
   RenderSettings settings_;
   std::vector<std::uint32_t> material_;
+  std::vector<Light> lights_;  // emissive lights expanded into triangles
   std::vector<Tri> triangles_;
   std::vector<Ball> spheres_;
 };
@@ -195,19 +262,36 @@ ReferenceImage reference_render(const Scene& scene, const RenderSettings& settin
   out.image.rgb.assign(pixels * 3, 0.0f);
   out.ambiguous.assign(pixels, 0);
   const double offsets[5][2] = {{0, 0}, {-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+  // The thin lens (kernels/render/generate.cl).
+  const Camera& camera = scene.camera;
+  const double lens_radius = camera.aperture;
+  const double focus = camera.focus_distance > 0.0f
+                           ? double(camera.focus_distance)
+                           : glm::length(dvec3(camera.look_at) - dvec3(camera.position));
+  const dvec3 right = glm::normalize(frame.du), up = -glm::normalize(frame.dv);
   for (std::uint32_t y = 0; y < settings.height; ++y)
     for (std::uint32_t x = 0; x < settings.width; ++x) {
       std::uint32_t pixel = y * settings.width + x;
       dvec3 sum(0.0);
       for (std::uint32_t sample = 0; sample < settings.spp; ++sample) {
-        float jx, jy;
-        rtcl_sample_position(pixel, sample, settings.spp, &jx, &jy);
+        const auto sampler = static_cast<std::uint32_t>(settings.sampler);
+        float su, sv, jx, jy;
+        rtcl_sample_2d(sampler, settings.seed, pixel, RTCL_DIM_PIXEL, sample, settings.spp, &su, &sv);
+        rtcl_filter_offset(static_cast<std::uint32_t>(settings.filter), su, sv, &jx, &jy);
+        dvec3 lens(0.0);
+        if (lens_radius > 0.0) {
+          float lu, lv, a, b;
+          rtcl_sample_2d(sampler, settings.seed, pixel, RTCL_DIM_LENS, sample, settings.spp, &lu, &lv);
+          rtcl_concentric_disc(lu, lv, &a, &b);
+          lens = lens_radius * (double(a) * right + double(b) * up);
+        }
         std::uint64_t signature[5] = {};
         for (int k = 0; k < 5; ++k) {
-          double fx = x + double(jx) + offsets[k][0] * ambiguity_px;
-          double fy = y + double(jy) + offsets[k][1] * ambiguity_px;
-          dvec3 d = glm::normalize(frame.corner + fx * frame.du + fy * frame.dv);
-          dvec3 radiance = tracer.trace(frame.origin, d, dvec3(1.0), 0, signature[k]);
+          double fx = x + 0.5 + double(jx) + offsets[k][0] * ambiguity_px;
+          double fy = y + 0.5 + double(jy) + offsets[k][1] * ambiguity_px;
+          dvec3 pinhole = frame.corner + fx * frame.du + fy * frame.dv;  // unit length along the view
+          dvec3 d = glm::normalize(lens_radius > 0.0 ? focus * pinhole - lens : pinhole);
+          dvec3 radiance = tracer.trace(frame.origin + lens, d, dvec3(1.0), 0, {pixel, sample}, signature[k]);
           if (k == 0) sum += radiance;
           if (signature[k] != signature[0]) out.ambiguous[pixel] = 1;
         }

@@ -1,8 +1,10 @@
 // Host reference of the Whitted renderer: the same algorithm as
-// kernels/render/shade.cl (IntersectColor with Phong, hard shadows, Fresnel-
-// weighted reflection and refraction, depth limit, weight threshold), the
-// same sample positions, but recursive, in double precision, single-threaded,
-// with brute-force intersection. For small images of small scenes.
+// kernels/render/shade.cl (IntersectColor with Phong, hard and soft shadows,
+// Fresnel-weighted reflection and refraction, glossy reflection, thin lens,
+// depth limit, weight threshold), the same sample points
+// (kernels/shared/sampling.h: sampler, seed, filter, light samples), but
+// recursive, in double precision, single-threaded, with brute-force
+// intersection. For small images of small scenes.
 #pragma once
 
 #include <cstdint>

@@ -4,6 +4,7 @@
 #include <set>
 
 #include "rtcl/render/render_layouts.hpp"
+#include "rtcl/scene/orthonormal_basis.hpp"
 
 namespace rtcl {
 
@@ -25,6 +26,42 @@ DeviceMaterial pack(const Material& m) {
   store(d.kt, m.kt);
   d.shininess = m.shininess;
   d.ior = m.ior;
+  d.roughness = m.roughness;
+  return d;
+}
+
+std::uint32_t shape_code(LightShape shape) {
+  switch (shape) {
+    case LightShape::quad: return RTCL_LIGHT_QUAD;
+    case LightShape::disc: return RTCL_LIGHT_DISC;
+    case LightShape::sphere: return RTCL_LIGHT_SPHERE;
+    case LightShape::triangle: return RTCL_LIGHT_TRIANGLE;
+    case LightShape::emissive:  // expanded into triangles before upload
+    case LightShape::point: break;
+  }
+  return RTCL_LIGHT_POINT;
+}
+
+// The device form of a light (render_layouts.h): a quad by a corner and its
+// edges, a disc by its centre and two radius vectors in its plane.
+DeviceLight pack(const Light& l) {
+  DeviceLight d{};
+  glm::dvec3 position(l.position);
+  if (l.shape == LightShape::quad) position -= 0.5 * (glm::dvec3(l.edge1) + glm::dvec3(l.edge2));
+  store(d.position, glm::vec3(position));
+  store(d.radiance, l.color * l.intensity);
+  d.shape = shape_code(l.shape);
+  if (l.shape == LightShape::quad || l.shape == LightShape::triangle) {
+    store(d.u, l.edge1);
+    store(d.v, l.edge2);
+  }
+  if (l.shape == LightShape::disc) {
+    glm::dvec3 n = glm::normalize(glm::dvec3(l.normal)), t1, t2;
+    orthonormal_basis(n, t1, t2);
+    store(d.u, glm::vec3(t1 * double(l.radius)));
+    store(d.v, glm::vec3(t2 * double(l.radius)));
+  }
+  if (l.shape == LightShape::sphere) d.radius = l.radius;
   return d;
 }
 
@@ -32,16 +69,25 @@ DeviceMaterial pack(const Material& m) {
 
 std::vector<std::string> shade_defines(const Scene& scene, const FlatScene& flat) {
   std::set<std::uint32_t> used(flat.material.begin(), flat.material.end());
-  bool reflection = false, refraction = false;
+  bool reflection = false, refraction = false, glossy = false, area = false;
   for (std::uint32_t m : used) {
     reflection = reflection || scene.materials[m].reflective() || scene.materials[m].transmissive();
     refraction = refraction || scene.materials[m].transmissive();
+    glossy = glossy || scene.materials[m].glossy();
   }
+  for (const Light& l : scene.lights) area = area || l.area();
   std::vector<std::string> defines{"RTCL_LIGHT_COUNT=" + std::to_string(scene.lights.size())};
   if (!flat.geometry.spheres.empty()) defines.push_back("RTCL_HAS_SPHERES");
   if (reflection) defines.push_back("RTCL_HAS_REFLECTION");
   if (refraction) defines.push_back("RTCL_HAS_REFRACTION");
+  if (glossy) defines.push_back("RTCL_HAS_GLOSSY");
+  if (area) defines.push_back("RTCL_HAS_AREA_LIGHTS");
   return defines;
+}
+
+std::vector<std::string> generate_defines(const Scene& scene) {
+  if (scene.camera.aperture > 0.0f) return {"RTCL_HAS_LENS"};
+  return {};
 }
 
 DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat) {
@@ -61,10 +107,7 @@ DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatSce
   for (const Material& m : scene.materials) materials.push_back(pack(m));
   if (materials.empty()) materials.emplace_back();
   std::vector<DeviceLight> lights(std::max<std::size_t>(scene.lights.size(), 1));
-  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
-    store(lights[l].position, scene.lights[l].position);
-    store(lights[l].radiance, scene.lights[l].color * scene.lights[l].intensity);
-  }
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) lights[l] = pack(scene.lights[l]);
   DeviceScene d;
   d.triangles = device.upload(triangles.data(), triangles.size() * sizeof(ShadeTriangle), "shading triangles");
   d.spheres = device.upload(spheres.data(), spheres.size() * sizeof(ShadeSphere), "shading spheres");
@@ -74,6 +117,7 @@ DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatSce
   d.sphere_count = static_cast<std::uint32_t>(g.spheres.size());
   d.light_count = static_cast<std::uint32_t>(scene.lights.size());
   d.defines = shade_defines(scene, flat);
+  d.generate_defines = generate_defines(scene);
   return d;
 }
 

@@ -20,11 +20,16 @@ struct DeviceScene {
   std::uint32_t triangle_count = 0, sphere_count = 0, light_count = 0;
   // RTCL_LIGHT_COUNT=n always; RTCL_HAS_SPHERES with spheres;
   // RTCL_HAS_REFLECTION when some primitive's material has kr > 0 or kt > 0;
-  // RTCL_HAS_REFRACTION when some primitive's material has kt > 0.
+  // RTCL_HAS_REFRACTION when some primitive's material has kt > 0;
+  // RTCL_HAS_AREA_LIGHTS with a quad, disc or sphere light; RTCL_HAS_GLOSSY
+  // when some primitive's reflecting material has roughness > 0.
   std::vector<std::string> defines;
+  // Of the camera-ray kernel: RTCL_HAS_LENS when the camera has an aperture.
+  std::vector<std::string> generate_defines;
 };
 
 std::vector<std::string> shade_defines(const Scene& scene, const FlatScene& flat);
+std::vector<std::string> generate_defines(const Scene& scene);
 DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat);
 
 }  // namespace rtcl

@@ -87,6 +87,10 @@ RayQueue::RayQueue(const Device& device) : device_(device) {
   });
 }
 
+void RayQueue::specialise_generation(const std::vector<std::string>& defines) {
+  with_cl_errors([&] { generate_ = cl::Kernel(device_.program("render/generate.cl", defines), "generate_camera_rays"); });
+}
+
 cl::Event RayQueue::generate_camera_rays(const cl::Buffer& camera, std::uint32_t first, std::uint32_t count,
                                          std::uint32_t sample, std::uint32_t spp,
                                          const std::vector<cl::Event>& wait) {

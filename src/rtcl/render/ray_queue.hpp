@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "rtcl/cl/device.hpp"
@@ -64,6 +65,10 @@ class RayQueue {
   const cl::Buffer& rays() const { return rays_.buffer(); }
   const cl::Buffer& paths() const { return paths_.buffer(); }
   std::size_t bytes() const { return rays_.bytes() + paths_.bytes(); }
+
+  // Rebuilds the camera-ray kernel with these -D options (generate.cl: a
+  // thin lens). The queue starts with none.
+  void specialise_generation(const std::vector<std::string>& defines);
 
   // Fills the queue with camera rays first .. first + count - 1 of the
   // screen-tile order for sample `sample` of `spp` (camera: a DeviceCamera).

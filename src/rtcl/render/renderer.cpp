@@ -39,6 +39,19 @@ void check_settings(const RenderSettings& s) {
   if (!std::isfinite(s.min_weight) || s.min_weight < 0.0f)
     throw Error("min weight " + std::to_string(s.min_weight) + ": must be finite and not negative");
   if (s.batch_pixels == 0) throw Error("batch size must be positive");
+  if (s.light_samples == 0 || s.light_samples > 4096)
+    throw Error("light samples " + std::to_string(s.light_samples) + ": must be 1 .. 4096");
+  if (std::uint64_t(s.spp) * s.light_samples > (1ull << 31))
+    throw Error("spp times light samples must be at most 2^31");
+  if (sampler_name(s.sampler) == "?") throw Error("unknown sampler (known: " + sampler_names() + ")");
+  if (filter_name(s.filter) == "?") throw Error("unknown filter (known: " + filter_names() + ")");
+}
+
+// Shadow slots per shaded ray: one per point light, `light_samples` per area light.
+std::uint32_t shadow_slots_per_ray(const Scene& scene, std::uint32_t light_samples) {
+  std::uint32_t slots = 0;
+  for (const Light& l : scene.lights) slots += l.area() ? light_samples : 1u;
+  return slots;
 }
 
 }  // namespace
@@ -61,6 +74,8 @@ struct Renderer::State {
   ShadowSlots shadow_slots;
   ShadowQueue shadows;
   std::vector<cl::Event> last;  // what the next stage waits for
+  std::uint32_t sample = 0;     // the pixel sample being traced
+  std::uint32_t slots_per_ray = 0;  // shadow slots per shaded ray
 
   RenderStats stats;
   std::vector<cl::Event> camera_traces, secondary_traces, shadow_traces, generates, shades, accumulates;
@@ -72,8 +87,11 @@ struct Renderer::State {
 Renderer::Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config)
     : s_(std::make_unique<State>(device, scene)) {
   s_->flat = flatten(scene);
+  s_->scene.lights = expand_emissive_lights(scene, s_->flat);
   s_->accel = make_accel(device, accel_name, s_->flat.geometry, config);
-  s_->shading = upload_scene(device, scene, s_->flat);
+  s_->shading = upload_scene(device, s_->scene, s_->flat);
+  s_->queue.specialise_generation(s_->shading.generate_defines);
+  s_->next.specialise_generation(s_->shading.generate_defines);
   if (config.precision == Precision::fast) s_->shading.defines.push_back("RTCL_FIXED_SPAWN_OFFSET");
   with_cl_errors([&] {
     cl::Program program = device.program("render/shade.cl", s_->shading.defines);
@@ -104,12 +122,28 @@ void Renderer::prepare(const RenderSettings& settings) {
   store(camera.dv, frame.dv);
   camera.width = settings.width;
   camera.height = settings.height;
+  const Camera& cam = s.scene.camera;
+  double aperture = cam.aperture;
+  store(camera.lens_u, glm::normalize(frame.du) * aperture);
+  store(camera.lens_v, -glm::normalize(frame.dv) * aperture);
+  camera.focus_distance = cam.focus_distance > 0.0f
+                              ? cam.focus_distance
+                              : static_cast<float>(glm::length(glm::dvec3(cam.look_at) - glm::dvec3(cam.position)));
+  camera.sampler = static_cast<rtcl_u32>(settings.sampler);
+  camera.seed = settings.seed;
+  camera.filter = static_cast<rtcl_u32>(settings.filter);
   ShadeParams params{};
   store(params.ambient, glm::dvec3(s.scene.ambient));
   store(params.background, glm::dvec3(s.scene.background));
   params.min_weight = settings.min_weight;
   params.max_depth = settings.max_depth;
   params.triangle_count = s.shading.triangle_count;
+  params.sampler = static_cast<rtcl_u32>(settings.sampler);
+  params.seed = settings.seed;
+  params.spp = settings.spp;
+  params.light_samples = settings.light_samples;
+  s.slots_per_ray = shadow_slots_per_ray(s.scene, settings.light_samples);
+  params.shadow_slots = s.slots_per_ray;
   s.camera = s.device.upload(&camera, sizeof camera, "camera");
   s.params = s.device.upload(&params, sizeof params, "shading parameters");
   s.framebuffer = s.device.allocate(std::size_t(pixels) * RTCL_RADIANCE_BYTES, "framebuffer");
@@ -130,6 +164,7 @@ Image Renderer::render(const RenderSettings& settings, const RenderProgress& pro
     for (std::uint32_t first = 0; first < pixels; first += settings.batch_pixels) {
       std::uint32_t count = std::min(settings.batch_pixels, pixels - first);
       double done = double(sample) * pixels + first;
+      s.sample = sample;
       generate(first, count, sample);
       for (std::uint32_t generation = 0; s.queue.size() > 0; ++generation) {
         trace(generation == 0);
@@ -169,6 +204,7 @@ Image Renderer::render(const RenderSettings& settings, const RenderProgress& pro
 std::vector<std::vector<TreeRay>> Renderer::ray_tree(const Ray& ray, const RenderSettings& settings) {
   prepare(settings);
   State& s = *s_;
+  s.sample = 0;
   std::vector<std::vector<TreeRay>> tree;
   std::vector<Ray> rays{ray};
   std::vector<PathState> paths{PathState{0, 0, 1.0f, 1.0f, 1.0f}};
@@ -216,8 +252,8 @@ void Renderer::shade() {
   State& s = *s_;
   std::size_t n = s.queue.size();
   s.radiance.reserve(s.device, n);
-  s.shadow_slots.reserve(s.device, std::max<std::size_t>(n * s.shading.light_count, 1));
-  s.shadow_slots.count = n * s.shading.light_count;
+  s.shadow_slots.reserve(s.device, std::max<std::size_t>(n * s.slots_per_ray, 1));
+  s.shadow_slots.count = n * s.slots_per_ray;
   s.spawn.reserve(s.device, 2 * n);
   with_cl_errors([&] {
     cl::Kernel& k = s.shade;
@@ -238,6 +274,7 @@ void Renderer::shade() {
     k.setArg(a++, s.spawn.rays.buffer());
     k.setArg(a++, s.spawn.paths.buffer());
     k.setArg(a++, s.spawn.flags.buffer());
+    k.setArg(a++, static_cast<cl_uint>(s.sample));
     cl::Event e = launch(s.device, k, n, s.last);
     s.shades.push_back(e);
     s.last = {e};
@@ -293,6 +330,7 @@ void Renderer::accumulate() {
     k.setArg(a++, s.shadow_slots.index.buffer());
     k.setArg(a++, s.shadows.size() > 0 ? s.shadows.hits() : s.hits.buffer());
     k.setArg(a++, s.framebuffer);
+    k.setArg(a++, static_cast<cl_uint>(s.slots_per_ray));
     cl::Event e = launch(s.device, k, n, s.last);
     s.accumulates.push_back(e);
     s.last = {e};

@@ -8,7 +8,8 @@
 // until the queue is empty or every path reached the depth limit. Each stage
 // is one function of Renderer; the kernels are built with -D options from
 // the scene (no refraction code without transmissive materials, no sphere
-// code without spheres, the light loop unrolled).
+// code without spheres, no area-light, glossy or lens code without area
+// lights, rough materials or an aperture; the light loop unrolled).
 #pragma once
 
 #include <cstdint>
@@ -22,14 +23,26 @@
 #include "rtcl/cl/device.hpp"
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/render_layouts.hpp"
+#include "rtcl/render/sampling_options.hpp"
 #include "rtcl/scene/scene.hpp"
 
 namespace rtcl {
 
 struct RenderSettings {
   std::uint32_t width = 512, height = 512;
-  // Jittered (stratified) samples per pixel; 1 traces pixel centres.
+  // Samples per pixel (anti-aliasing, and the pixel's share of every other
+  // distributed effect); with the stratified sampler, 1 traces pixel centres.
   std::uint32_t spp = 1;
+  // Where the samples of every distributed decision (sub-pixel position,
+  // lens, light point, glossy direction) lie: kernels/shared/sampling.h.
+  // Each pixel's samples are a pure function of (pixel, sample, seed).
+  Sampler sampler = Sampler::stratified;
+  std::uint32_t seed = 0;
+  // Reconstruction filter, by filter importance sampling (sampling.h).
+  Filter filter = Filter::box;
+  // Shadow rays per area light and shading point (soft shadows; point
+  // lights take one). Speed/accuracy knob.
+  std::uint32_t light_samples = 1;
   // Reflection/refraction bounces after the camera ray's hit (0: local
   // shading and shadows only). Speed/accuracy knob.
   std::uint32_t max_depth = 5;

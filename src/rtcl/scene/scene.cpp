@@ -32,6 +32,10 @@ void validate_camera(const Scene& scene) {
     throw Error(where + "up is zero or parallel to the view direction");
   if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f)) throw Error(where + "fov must lie in (0, 180) degrees");
   if (c.aspect < 0.0f) throw Error(where + "aspect must be positive");
+  if (!std::isfinite(c.aperture) || c.aperture < 0.0f)
+    throw Error(where + "aperture must be finite and not negative (got " + std::to_string(c.aperture) + ")");
+  if (!std::isfinite(c.focus_distance) || c.focus_distance < 0.0f)
+    throw Error(where + "focus_distance must be positive (got " + std::to_string(c.focus_distance) + ")");
 }
 
 void validate_material(const Scene& scene, std::size_t i) {
@@ -47,6 +51,21 @@ void validate_material(const Scene& scene, std::size_t i) {
     throw Error(scene.source + ": " + where + "shininess must be finite and not negative");
   if (!std::isfinite(m.ior) || !(m.ior > 0.0f))
     throw Error(scene.source + ": " + where + "ior must be positive (got " + std::to_string(m.ior) + ")");
+  if (!(m.roughness >= 0.0f && m.roughness <= 1.0f))
+    throw Error(scene.source + ": " + where + "roughness must lie in [0, 1] (got " + std::to_string(m.roughness) + ")");
+}
+
+void validate_light(const Scene& scene, std::size_t i) {
+  const Light& l = scene.lights[i];
+  std::string where = scene.source + ": lights[" + std::to_string(i) + "] ";
+  if (!finite(l.position)) throw Error(where + "position must be finite");
+  check_colour(scene, "lights[" + std::to_string(i) + "] color", l.color);
+  if (!std::isfinite(l.intensity) || l.intensity < 0.0f) throw Error(where + "intensity must be finite and not negative");
+  if (!finite(l.edge1) || !finite(l.edge2)) throw Error(where + "edge1 and edge2 must be finite");
+  if (!std::isfinite(l.radius) || l.radius < 0.0f)
+    throw Error(where + "radius must be finite and not negative (got " + std::to_string(l.radius) + ")");
+  if (l.shape == LightShape::disc && (!finite(l.normal) || glm::length(glm::dvec3(l.normal)) == 0.0))
+    throw Error(where + "normal of a disc light must be finite and not zero");
 }
 
 glm::vec3 apply_point(const glm::dmat4& m, const glm::vec3& p) { return glm::vec3(m * glm::dvec4(glm::dvec3(p), 1.0)); }
@@ -69,14 +88,7 @@ void validate(const Scene& scene) {
   validate_camera(scene);
   check_colour(scene, "ambient", scene.ambient);
   check_colour(scene, "background", scene.background);
-  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
-    const PointLight& l = scene.lights[i];
-    std::string where = "lights[" + std::to_string(i) + "] ";
-    if (!finite(l.position)) throw Error(scene.source + ": " + where + "position must be finite");
-    check_colour(scene, where + "color", l.color);
-    if (!std::isfinite(l.intensity) || l.intensity < 0.0f)
-      throw Error(scene.source + ": " + where + "intensity must be finite and not negative");
-  }
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) validate_light(scene, i);
   for (std::size_t i = 0; i < scene.materials.size(); ++i) validate_material(scene, i);
   for (const SceneMesh& mesh : scene.meshes) {
     if (mesh.materials.size() != mesh.triangles.size())
@@ -120,13 +132,63 @@ FlatScene flatten(const Scene& scene) {
   return flat;
 }
 
+std::vector<Light> expand_emissive_lights(const Scene& scene, const FlatScene& flat) {
+  std::vector<Light> out;
+  const Geometry& g = flat.geometry;
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    if (l.shape != LightShape::emissive) {
+      out.push_back(l);
+      continue;
+    }
+    struct Emitter {
+      glm::dvec3 v0, e1, e2;
+      glm::vec3 emission;
+      double area;
+    };
+    std::vector<Emitter> emitters;
+    double total = 0.0;
+    for (std::size_t t = 0; t < g.triangles.size(); ++t) {
+      const Material& m = scene.materials[flat.material[t]];
+      if (!glm::any(glm::greaterThan(m.emission, glm::vec3(0.0f)))) continue;
+      glm::dvec3 v0(g.vertices[g.triangles[t][0]]), v1(g.vertices[g.triangles[t][1]]), v2(g.vertices[g.triangles[t][2]]);
+      double area = 0.5 * glm::length(glm::cross(v1 - v0, v2 - v0));
+      if (!(area > 0.0)) continue;
+      emitters.push_back({v0, v1 - v0, v2 - v0, m.emission, area});
+      total += area;
+    }
+    if (emitters.empty())
+      throw Error(scene.source + ": lights[" + std::to_string(i) +
+                  "]: an emissive light, but no triangle's material has emission > 0");
+    for (const Emitter& e : emitters) {
+      Light t;
+      t.shape = LightShape::triangle;
+      t.position = glm::vec3(e.v0);
+      t.edge1 = glm::vec3(e.e1);
+      t.edge2 = glm::vec3(e.e2);
+      t.color = glm::vec3(glm::dvec3(e.emission) * glm::dvec3(l.color) * (e.area / total));
+      t.intensity = l.intensity;
+      out.push_back(t);
+    }
+  }
+  return out;
+}
+
 Scene transform_scene(const Scene& scene, const glm::dmat4& t) {
   double s = similarity_scale(t, scene.source);
   Scene out = scene;
   out.camera.position = apply_point(t, scene.camera.position);
   out.camera.look_at = apply_point(t, scene.camera.look_at);
   out.camera.up = glm::vec3(glm::dmat3(t) * glm::dvec3(scene.camera.up) / s);
-  for (PointLight& l : out.lights) l.position = apply_point(t, l.position);
+  out.camera.aperture = static_cast<float>(scene.camera.aperture * s);
+  out.camera.focus_distance = static_cast<float>(scene.camera.focus_distance * s);
+  for (Light& l : out.lights) {
+    l.position = apply_point(t, l.position);
+    l.edge1 = glm::vec3(glm::dmat3(t) * glm::dvec3(l.edge1));
+    l.edge2 = glm::vec3(glm::dmat3(t) * glm::dvec3(l.edge2));
+    l.normal = glm::vec3(glm::dmat3(t) * glm::dvec3(l.normal) / s);
+    l.radius = static_cast<float>(l.radius * s);
+  }
   for (SceneMesh& m : out.meshes) m.transform = t * m.transform;
   for (SceneSphere& sp : out.spheres) {
     sp.center = glm::dvec3(t * glm::dvec4(sp.center, 1.0));

@@ -1,4 +1,5 @@
-// The scene model of the renderer: a pinhole camera, point lights, Phong
+// The scene model of the renderer: a pinhole or thin-lens camera, point and
+// area lights, Phong
 // materials with Whitted reflection/refraction, triangle meshes with
 // per-object transforms and analytic spheres; and its flattening into the
 // Geometry the acceleration structures are built over, with one material per
@@ -29,16 +30,36 @@ struct Material {
   glm::vec3 kr{0.0f};        // mirror reflectance, each in [0, 1]
   glm::vec3 kt{0.0f};        // transmittance, each in [0, 1]; Fresnel splits it into reflection and refraction
   float ior = 1.5f;          // index of refraction inside the surface (> 0; outside is 1)
+  // 0: the reflected ray is the mirror direction; in (0, 1]: it is drawn from
+  // the Phong lobe of exponent 2 / roughness^2 - 2 around it (glossy).
+  float roughness = 0.0f;
 
   bool reflective() const { return glm::any(glm::greaterThan(kr, glm::vec3(0.0f))); }
   bool transmissive() const { return glm::any(glm::greaterThan(kt, glm::vec3(0.0f))); }
+  bool glossy() const { return roughness > 0.0f && (reflective() || transmissive()); }
 };
 
-struct PointLight {
-  glm::vec3 position{0.0f};
+// emissive: every triangle whose material has emission > 0 lights the scene
+// (expand_emissive_lights turns it into one triangle light per triangle).
+enum class LightShape { point, quad, disc, sphere, emissive, triangle };
+
+// A light. An area light (quad, disc, sphere, triangle) is the average of
+// point lights of its radiance over its points, uniformly by area (a sphere:
+// over the disc through its centre that faces the shaded point): soft
+// shadows, and a light of size zero is the point light. An emissive light's
+// radiance at a triangle's point is the triangle's emission times color times
+// intensity.
+struct Light {
+  glm::vec3 position{0.0f};  // point: the point; quad, disc, sphere: the centre; triangle: a corner
   glm::vec3 color{1.0f};
   float intensity = 1.0f;  // radiance = color * intensity, no distance falloff
+  LightShape shape = LightShape::point;
+  glm::vec3 edge1{0.0f}, edge2{0.0f};  // quad: its two edge vectors (full lengths); triangle: from the corner
+  glm::vec3 normal{0.0f, -1.0f, 0.0f};  // disc: its normal (non-zero; either side lights alike)
+  float radius = 0.0f;                  // disc, sphere: >= 0
+  bool area() const { return shape != LightShape::point; }
 };
+using PointLight = Light;
 
 struct Camera {
   glm::vec3 position{0.0f, 0.0f, 5.0f};
@@ -46,6 +67,11 @@ struct Camera {
   glm::vec3 up{0.0f, 1.0f, 0.0f};
   float fov_deg = 45.0f;  // vertical field of view, in (0, 180)
   float aspect = 0.0f;    // width / height the scene is framed for; 0: none (the image decides)
+  // Thin lens: radius of the aperture (scene units, >= 0; 0 is the pinhole)
+  // and the distance along the view direction that is in focus (> 0; 0
+  // here: the distance to look_at).
+  float aperture = 0.0f;
+  float focus_distance = 0.0f;
 };
 
 // A triangle mesh in object space with its object-to-world transform.
@@ -69,7 +95,7 @@ struct Scene {
   Camera camera;
   glm::vec3 ambient{0.0f};     // ambient light
   glm::vec3 background{0.0f};  // radiance of rays that leave the scene
-  std::vector<PointLight> lights;
+  std::vector<Light> lights;
   std::vector<Material> materials;
   std::vector<SceneMesh> meshes;
   std::vector<SceneSphere> spheres;
@@ -84,9 +110,10 @@ struct Scene {
 };
 
 // Throws Error naming scene.source and the element for: a degenerate camera
-// (position = look_at, up parallel to the view, fov outside (0, 180)), a
-// negative colour or intensity, kr/kt outside [0, 1], ior <= 0, a negative
-// shininess, a material index out of range, a non-finite number anywhere,
+// (position = look_at, up parallel to the view, fov outside (0, 180), a
+// negative aperture or focus distance), a negative colour, intensity or light
+// radius, a disc light without a normal, kr/kt/roughness outside [0, 1],
+// ior <= 0, a negative shininess, a material index out of range, a non-finite number anywhere,
 // or a scene with no mesh and no sphere.
 void validate(const Scene& scene);
 
@@ -98,6 +125,13 @@ struct FlatScene {
   std::vector<std::uint32_t> material;
 };
 FlatScene flatten(const Scene& scene);
+
+// scene.lights with each emissive light replaced by one triangle light per
+// emitting triangle of `flat` (in primitive order), each of radiance emission
+// * color * intensity times its share of the emitters' total area (so that
+// together they are the average over the emitters' points). Throws Error
+// naming the light when no triangle emits.
+std::vector<Light> expand_emissive_lights(const Scene& scene, const FlatScene& flat);
 
 // The scene moved by a similarity transform (rotation, uniform scale,
 // translation): camera, lights, meshes and spheres. Throws Error when

@@ -119,7 +119,7 @@ glm::dmat4 read_transform(const Reader& r, const json& v, const std::string& whe
 
 Camera read_camera(const Reader& r, const json& v) {
   const std::string where = "camera";
-  r.object(v, where, {"position", "look_at", "up", "fov", "aspect"});
+  r.object(v, where, {"position", "look_at", "up", "fov", "aspect", "aperture", "focus_distance"});
   Camera c;
   c.position = to_float(r.vec3(r.required(v, where, "position"), "camera.position"));
   c.look_at = to_float(r.vec3(r.required(v, where, "look_at"), "camera.look_at"));
@@ -130,13 +130,54 @@ Camera read_camera(const Reader& r, const json& v) {
     if (!(c.aspect > 0.0f)) r.fail("camera.aspect", "must be positive");
   }
   if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f)) r.fail("camera.fov", "must lie in (0, 180) degrees");
+  if (v.contains("aperture")) {
+    double a = r.number(v["aperture"], "camera.aperture");
+    if (!(a >= 0.0)) r.fail("camera.aperture", "the lens radius must not be negative (0: pinhole), got " + v["aperture"].dump());
+    c.aperture = static_cast<float>(a);
+  }
+  if (v.contains("focus_distance")) {
+    double f = r.number(v["focus_distance"], "camera.focus_distance");
+    if (!(f > 0.0)) r.fail("camera.focus_distance", "must be positive, got " + v["focus_distance"].dump());
+    c.focus_distance = static_cast<float>(f);
+  }
   return c;
 }
 
-PointLight read_light(const Reader& r, const json& v, const std::string& where) {
-  r.object(v, where, {"position", "color", "intensity"});
-  PointLight l;
-  l.position = to_float(r.vec3(r.required(v, where, "position"), Reader::join(where, "position")));
+Light read_light(const Reader& r, const json& v, const std::string& where) {
+  r.object(v, where, {"type", "position", "color", "intensity", "edge1", "edge2", "normal", "radius"});
+  Light l;
+  std::string type = v.contains("type") ? r.string(v["type"], Reader::join(where, "type")) : "point";
+  if (type == "point") l.shape = LightShape::point;
+  else if (type == "quad") l.shape = LightShape::quad;
+  else if (type == "disc") l.shape = LightShape::disc;
+  else if (type == "sphere") l.shape = LightShape::sphere;
+  else if (type == "emissive") l.shape = LightShape::emissive;
+  else r.fail(Reader::join(where, "type"), "unknown light type '" + type + "' (known: point, quad, disc, sphere, emissive)");
+  // The keys each shape takes (beyond position, color, intensity, type).
+  auto allow = [&](const char* key, bool allowed) {
+    if (v.contains(key) && !allowed) r.fail(Reader::join(where, key), "not a key of " + std::string(type == "emissive" ? "an " : "a ") + type + " light");
+  };
+  allow("edge1", l.shape == LightShape::quad);
+  allow("edge2", l.shape == LightShape::quad);
+  allow("normal", l.shape == LightShape::disc);
+  allow("radius", l.shape == LightShape::disc || l.shape == LightShape::sphere);
+  allow("position", l.shape != LightShape::emissive);
+  if (l.shape == LightShape::quad) {
+    l.edge1 = to_float(r.vec3(r.required(v, where, "edge1"), Reader::join(where, "edge1")));
+    l.edge2 = to_float(r.vec3(r.required(v, where, "edge2"), Reader::join(where, "edge2")));
+  }
+  if (l.shape == LightShape::disc) {
+    glm::dvec3 n = r.vec3(r.required(v, where, "normal"), Reader::join(where, "normal"));
+    if (glm::length(n) == 0.0) r.fail(Reader::join(where, "normal"), "must not be zero");
+    l.normal = to_float(n);
+  }
+  if (l.shape == LightShape::disc || l.shape == LightShape::sphere) {
+    double radius = r.number(r.required(v, where, "radius"), Reader::join(where, "radius"));
+    if (!(radius >= 0.0)) r.fail(Reader::join(where, "radius"), "must not be negative (0: a point light), got " + v["radius"].dump());
+    l.radius = static_cast<float>(radius);
+  }
+  if (l.shape != LightShape::emissive)
+    l.position = to_float(r.vec3(r.required(v, where, "position"), Reader::join(where, "position")));
   if (v.contains("color")) l.color = to_float(r.triple(v["color"], Reader::join(where, "color")));
   if (v.contains("intensity")) l.intensity = static_cast<float>(r.number(v["intensity"], Reader::join(where, "intensity")));
   if (l.intensity < 0.0f) r.fail(Reader::join(where, "intensity"), "must not be negative");
@@ -144,7 +185,7 @@ PointLight read_light(const Reader& r, const json& v, const std::string& where) 
 }
 
 Material read_material(const Reader& r, const json& v, const std::string& name, const std::string& where) {
-  r.object(v, where, {"ambient", "diffuse", "specular", "shininess", "emission", "kr", "kt", "ior"});
+  r.object(v, where, {"ambient", "diffuse", "specular", "shininess", "emission", "kr", "kt", "ior", "roughness"});
   Material m;
   m.name = name;
   auto colour = [&](const char* key, glm::vec3& out, bool unit) {
@@ -170,6 +211,12 @@ Material read_material(const Reader& r, const json& v, const std::string& name, 
     double ior = r.number(v["ior"], Reader::join(where, "ior"));
     if (!(ior > 0.0)) r.fail(Reader::join(where, "ior"), "index of refraction must be positive (got " + v["ior"].dump() + ")");
     m.ior = static_cast<float>(ior);
+  }
+  if (v.contains("roughness")) {
+    double rough = r.number(v["roughness"], Reader::join(where, "roughness"));
+    if (!(rough >= 0.0 && rough <= 1.0))
+      r.fail(Reader::join(where, "roughness"), "must lie in [0, 1] (0: mirror), got " + v["roughness"].dump());
+    m.roughness = static_cast<float>(rough);
   }
   return m;
 }
