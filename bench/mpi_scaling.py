@@ -1,0 +1,112 @@
+#!/usr/bin/python3
+"""Parallel efficiency and tile-size cost of `rtcl render` under mpirun on
+this host, and the numbers behind the 8- and 64-rank model (README, "rtcl
+render under mpirun").
+
+  flock /tmp/rtcl-bench.lock nice -n -20 /usr/bin/python3 bench/mpi_scaling.py [--build build] [--repeats 3]
+
+Each rank gets its share of the cores: POCL_MAX_PTHREAD_COUNT = cores / N
+(PoCL's worker threads), processes unbound (--bind-to none: Open MPI would
+otherwise pin a single rank to one core). T(N) is the time from the first
+tile handed out to the last tile in (the figure `rtcl render` prints as "in
+X s" under mpirun), the median of --repeats runs interleaved over N;
+efficiency E(N) = T(1) / (N T(N)). The single-process render (no mpirun,
+all cores) is the baseline. Per-tile costs come from the ranks' own
+Renderer::render times and rank 0's hand-out-to-return times.
+"""
+import argparse
+import os
+import re
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+
+SUMMARY = re.compile(r"rays in ([0-9.]+) s")
+TILES = re.compile(r"(\d+) tiles of (\d+) px")
+RANK = re.compile(r"rank (\d+) \(host [^,]*, device .*?\): .*?(\d+) tiles: rendering ([0-9.]+) ms, handed out to returned ([0-9.]+) ms")
+
+
+def run(cmd, env):
+    out = subprocess.run(cmd, env=env, capture_output=True, text=True)
+    if out.returncode != 0:
+        sys.exit(f"mpi_scaling: {' '.join(cmd)} failed ({out.returncode}):\n{out.stderr}")
+    return out.stdout
+
+
+def render(rtcl, ranks, cores, tile, args, workdir):
+    env = dict(os.environ, POCL_MAX_PTHREAD_COUNT=str(max(1, cores // max(ranks, 1))))
+    out_file = os.path.join(workdir, "scaling.png")
+    base = [rtcl, "render", "-q", "-o", out_file] + args
+    if ranks == 0:  # the single-process render, no MPI
+        text = run(base, env)
+        return {"seconds": float(SUMMARY.search(text).group(1))}
+    mpirun = [shutil.which("mpirun"), "--allow-run-as-root", "--oversubscribe", "--bind-to", "none",
+              "-x", "POCL_MAX_PTHREAD_COUNT", "-x", "POCL_CACHE_DIR", "-np", str(ranks)]
+    text = run(mpirun + base + ["--tile", str(tile)], env)
+    result = {"seconds": float(SUMMARY.search(text).group(1)), "tiles": int(TILES.search(text).group(1)),
+              "ranks": []}
+    for m in RANK.finditer(text):
+        result["ranks"].append({"rank": int(m.group(1)), "tiles": int(m.group(2)), "render_ms": float(m.group(3)),
+                                "round_trip_ms": float(m.group(4))})
+    return result
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--build", default="build")
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--width", type=int, default=384)
+    p.add_argument("--spp", type=int, default=4)
+    p.add_argument("--tile", type=int, default=32)
+    p.add_argument("--tiles", default="8,16,32,64,128", help="tile sizes of the tile-cost table (N = 2)")
+    p.add_argument("--cores", type=int, default=os.cpu_count())
+    o = p.parse_args()
+    rtcl = os.path.abspath(os.path.join(o.build, "rtcl"))
+    os.environ.setdefault("POCL_CACHE_DIR", os.path.abspath(os.path.join(o.build, "pocl-cache-bench")))
+    args = ["--width", str(o.width), "--spp", str(o.spp)]
+    with tempfile.TemporaryDirectory() as work:
+        render(rtcl, 1, o.cores, o.tile, args, work)  # warm PoCL's kernel cache
+        runs = {0: [], 1: [], 2: []}
+        for _ in range(o.repeats):
+            for n in runs:
+                runs[n].append(render(rtcl, n, o.cores, o.tile, args, work))
+        med = {n: statistics.median(r["seconds"] for r in rs) for n, rs in runs.items()}
+        print(f"default scene, {o.width}x{o.width}, {o.spp} spp, depth 5, tile {o.tile}; {o.cores} cores; "
+              f"median of {o.repeats}\n")
+        print("| ranks | PoCL threads per rank | T (s) | speed-up over N = 1 | efficiency | vs single process |")
+        print("|---:|---:|---:|---:|---:|---:|")
+        print(f"| single process | {o.cores} | {med[0]:.3f} | | | 1.00 |")
+        for n in (1, 2):
+            print(f"| {n} | {max(1, o.cores // n)} | {med[n]:.3f} | {med[1] / med[n]:.2f} | "
+                  f"{med[1] / (n * med[n]):.2f} | {med[0] / med[n]:.2f} |")
+        # Per-tile figures of the N = 2 runs: render time on the rank, and
+        # rank 0's hand-out-to-return time of rank 1's tiles less rank 1's
+        # own render time (messages, waiting for rank 0's poll).
+        remote = [r for run_ in runs[2] for r in run_["ranks"] if r["rank"] == 1 and r["tiles"] > 0]
+        render_per_tile = statistics.median(r["render_ms"] / r["tiles"] for r in remote) if remote else 0.0
+        comm_per_tile = statistics.median((r["round_trip_ms"] - r["render_ms"]) / r["tiles"] for r in remote) if remote else 0.0
+        tiles = runs[2][0]["tiles"]
+        print(f"\nN = 2: {tiles} tiles; rank 1 per tile: rendering {render_per_tile:.2f} ms, "
+              f"communication and hand-out {comm_per_tile:.3f} ms (medians)\n")
+
+        sizes = [int(t) for t in o.tiles.split(",")]
+        sweep = {t: [] for t in sizes}
+        for _ in range(o.repeats):
+            for t in sizes:
+                sweep[t].append(render(rtcl, 2, o.cores, t, args, work))
+        print("| tile (px) | tiles | T (s), N = 2 | relative to the best | rank 1 ms per tile: rendering | communication |")
+        print("|---:|---:|---:|---:|---:|---:|")
+        best = min(statistics.median(r["seconds"] for r in rs) for rs in sweep.values())
+        for t in sizes:
+            rs = sweep[t]
+            m = statistics.median(r["seconds"] for r in rs)
+            rem = [x for r in rs for x in r["ranks"] if x["rank"] == 1 and x["tiles"] > 0]
+            rt = statistics.median(x["render_ms"] / x["tiles"] for x in rem) if rem else float("nan")
+            ct = statistics.median((x["round_trip_ms"] - x["render_ms"]) / x["tiles"] for x in rem) if rem else float("nan")
+            print(f"| {t} | {rs[0]['tiles']} | {m:.3f} | {m / best:.2f} | {rt:.2f} | {ct:.3f} |")
+
+
+if __name__ == "__main__":
+    main()
