@@ -7,12 +7,16 @@ render under mpirun").
 
 Each rank gets its share of the cores: POCL_MAX_PTHREAD_COUNT = cores / N
 (PoCL's worker threads), processes unbound (--bind-to none: Open MPI would
-otherwise pin a single rank to one core). T(N) is the time from the first
+otherwise pin a single rank to one core). T(N, t) is the time from the first
 tile handed out to the last tile in (the figure `rtcl render` prints as "in
-X s" under mpirun), the median of --repeats runs interleaved over N;
-efficiency E(N) = T(1) / (N T(N)). The single-process render (no mpirun,
-all cores) is the baseline. Per-tile costs come from the ranks' own
-Renderer::render times and rank 0's hand-out-to-return times.
+X s" under mpirun) with N ranks of t PoCL threads each, the median of
+--repeats runs interleaved over the configurations. Two efficiencies:
+per core, T(1, 1) / (N T(N, 1)) (N ranks of one core against one rank of
+one core), and on the whole machine, T(1, cores) / T(cores, 1) (the same
+cores as one rank or as one rank per core: the cost of going through MPI).
+The single-process render (no mpirun, all cores) is the baseline of both.
+Per-tile costs come from the ranks' own Renderer::render times and rank 0's
+hand-out-to-return times.
 """
 import argparse
 import os
@@ -35,8 +39,8 @@ def run(cmd, env):
     return out.stdout
 
 
-def render(rtcl, ranks, cores, tile, args, workdir):
-    env = dict(os.environ, POCL_MAX_PTHREAD_COUNT=str(max(1, cores // max(ranks, 1))))
+def render(rtcl, ranks, threads, tile, args, workdir):
+    env = dict(os.environ, POCL_MAX_PTHREAD_COUNT=str(threads))
     out_file = os.path.join(workdir, "scaling.png")
     base = [rtcl, "render", "-q", "-o", out_file] + args
     if ranks == 0:  # the single-process render, no MPI
@@ -59,8 +63,8 @@ def main():
     p.add_argument("--repeats", type=int, default=3)
     p.add_argument("--width", type=int, default=384)
     p.add_argument("--spp", type=int, default=4)
-    p.add_argument("--tile", type=int, default=32)
-    p.add_argument("--tiles", default="8,16,32,64,128", help="tile sizes of the tile-cost table (N = 2)")
+    p.add_argument("--tile", type=int, default=64)
+    p.add_argument("--tiles", default="8,16,32,64,128", help="tile sizes of the tile-cost table (one rank per core)")
     p.add_argument("--cores", type=int, default=os.cpu_count())
     o = p.parse_args()
     rtcl = os.path.abspath(os.path.join(o.build, "rtcl"))
@@ -68,35 +72,43 @@ def main():
     args = ["--width", str(o.width), "--spp", str(o.spp)]
     with tempfile.TemporaryDirectory() as work:
         render(rtcl, 1, o.cores, o.tile, args, work)  # warm PoCL's kernel cache
-        runs = {0: [], 1: [], 2: []}
+        # (ranks, PoCL threads per rank); ranks 0: the single process
+        configs = [(0, o.cores), (1, o.cores), (1, 1), (o.cores, 1)]
+        runs = {c: [] for c in configs}
         for _ in range(o.repeats):
-            for n in runs:
-                runs[n].append(render(rtcl, n, o.cores, o.tile, args, work))
-        med = {n: statistics.median(r["seconds"] for r in rs) for n, rs in runs.items()}
+            for c in configs:
+                runs[c].append(render(rtcl, c[0], c[1], o.tile, args, work))
+        med = {c: statistics.median(r["seconds"] for r in rs) for c, rs in runs.items()}
+        single, one_core, machine = med[(0, o.cores)], med[(1, 1)], med[(1, o.cores)]
         print(f"default scene, {o.width}x{o.width}, {o.spp} spp, depth 5, tile {o.tile}; {o.cores} cores; "
               f"median of {o.repeats}\n")
-        print("| ranks | PoCL threads per rank | T (s) | speed-up over N = 1 | efficiency | vs single process |")
-        print("|---:|---:|---:|---:|---:|---:|")
-        print(f"| single process | {o.cores} | {med[0]:.3f} | | | 1.00 |")
-        for n in (1, 2):
-            print(f"| {n} | {max(1, o.cores // n)} | {med[n]:.3f} | {med[1] / med[n]:.2f} | "
-                  f"{med[1] / (n * med[n]):.2f} | {med[0] / med[n]:.2f} |")
-        # Per-tile figures of the N = 2 runs: render time on the rank, and
-        # rank 0's hand-out-to-return time of rank 1's tiles less rank 1's
-        # own render time (messages, waiting for rank 0's poll).
-        remote = [r for run_ in runs[2] for r in run_["ranks"] if r["rank"] == 1 and r["tiles"] > 0]
+        print("| ranks | PoCL threads per rank | T (s) | efficiency per core | efficiency on the machine | "
+              "single process / T |")
+        print("|---|---:|---:|---:|---:|---:|")
+        for c in configs:
+            n, t = c
+            per_core = f"{one_core / (n * med[c]):.2f}" if n > 0 and t == 1 else ""
+            on_machine = f"{machine / med[c]:.2f}" if n * t == o.cores else ""
+            print(f"| {'single process' if n == 0 else n} | {t} | {med[c]:.3f} | {per_core} | {on_machine} | "
+                  f"{single / med[c]:.2f} |")
+        # Per-tile figures of the runs with one rank per core: render time on
+        # rank 1, and rank 0's hand-out-to-return time of rank 1's tiles less
+        # rank 1's own render time (messages, waiting for rank 0's poll).
+        split = runs[(o.cores, 1)]
+        remote = [r for run_ in split for r in run_["ranks"] if r["rank"] == 1 and r["tiles"] > 0]
         render_per_tile = statistics.median(r["render_ms"] / r["tiles"] for r in remote) if remote else 0.0
         comm_per_tile = statistics.median((r["round_trip_ms"] - r["render_ms"]) / r["tiles"] for r in remote) if remote else 0.0
-        tiles = runs[2][0]["tiles"]
-        print(f"\nN = 2: {tiles} tiles; rank 1 per tile: rendering {render_per_tile:.2f} ms, "
+        tiles = split[0]["tiles"]
+        print(f"\nN = {o.cores}: {tiles} tiles; rank 1 per tile: rendering {render_per_tile:.2f} ms, "
               f"communication and hand-out {comm_per_tile:.3f} ms (medians)\n")
 
         sizes = [int(t) for t in o.tiles.split(",")]
         sweep = {t: [] for t in sizes}
         for _ in range(o.repeats):
             for t in sizes:
-                sweep[t].append(render(rtcl, 2, o.cores, t, args, work))
-        print("| tile (px) | tiles | T (s), N = 2 | relative to the best | rank 1 ms per tile: rendering | communication |")
+                sweep[t].append(render(rtcl, o.cores, 1, t, args, work))
+        print(f"| tile (px) | tiles | T (s), {o.cores} ranks | relative to the best | rank 1 ms per tile: rendering | "
+              "communication |")
         print("|---:|---:|---:|---:|---:|---:|")
         best = min(statistics.median(r["seconds"] for r in rs) for rs in sweep.values())
         for t in sizes:

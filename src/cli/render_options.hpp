@@ -28,7 +28,7 @@ struct RenderOptions {
   // tiles are handed out in (rows | shuffled), and where ranks get the
   // scene from (root: read on rank 0 and broadcast; each: every rank reads
   // the file itself, e.g. from a shared file system).
-  std::uint32_t tile = 32;
+  std::uint32_t tile = 64;
   std::string tile_order = "rows";
   std::string scene_from = "root";
 };

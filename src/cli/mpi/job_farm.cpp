@@ -109,12 +109,17 @@ class LocalWorker {
   std::thread thread_;
 };
 
-enum class State { starting, idle, busy, failed, stopped };
+// Jobs out at once per remote rank: the next job waits in the rank's
+// message queue while it renders the current one, so a rank does not sit
+// idle for the round trip through rank 0 between two jobs.
+constexpr std::size_t jobs_ahead = 2;
+
+enum class State { starting, working, failed, stopped };
 
 struct Remote {
   State state = State::starting;
-  std::size_t job = 0;
-  Clock::time_point sent;
+  std::deque<std::size_t> jobs;  // handed out, results not yet in (a rank returns them in order)
+  Clock::time_point since;       // the oldest job's hand-out, or the last result
 };
 
 }  // namespace
@@ -140,9 +145,11 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
     std::fprintf(stderr, "rtcl: warning: %s failed%s: %s%s\n", describe(rank, o, hosts[rank]).c_str(),
                  job < 0 ? " while setting up" : (" on job " + std::to_string(job)).c_str(), message.c_str(),
                  job < 0 ? "" : "; the job goes to another rank");
-    if (job >= 0) {
-      std::lock_guard lock(mutex);
-      pending.push_front(static_cast<std::size_t>(job));
+    std::lock_guard lock(mutex);
+    if (job >= 0 && (rank == 0 || remotes[rank].jobs.empty())) pending.push_front(static_cast<std::size_t>(job));
+    if (rank > 0) {  // the failed job and those queued behind it
+      for (auto j = remotes[rank].jobs.rbegin(); j != remotes[rank].jobs.rend(); ++j) pending.push_front(*j);
+      remotes[rank].jobs.clear();
     }
   };
 
@@ -150,18 +157,22 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
     LocalWorker local(pending, mutex, wake, setup, run);
     auto stop_remotes = [&] {
       for (int r = 1; r < world.size; ++r) {
-        // A starting rank's hello or failure is on its way, a busy one's
-        // result (dropped: only an error ends the run with jobs out).
-        while (remotes[r].state == State::starting || remotes[r].state == State::busy) {
+        // A starting rank's hello or failure is on its way, a working
+        // one's results (dropped: only an error ends the run with jobs out).
+        while (remotes[r].state == State::starting ||
+               (remotes[r].state == State::working && !remotes[r].jobs.empty())) {
           Message m = wait_message(r);
-          if (m.tag == tag_hello) outcomes[r].report = nlohmann::json::parse(as_text(m.bytes));
-          if (m.tag == tag_hello || m.tag == tag_result) remotes[r].state = State::idle;
-          else if (m.tag == tag_failed) {
+          if (m.tag == tag_hello) {
+            outcomes[r].report = nlohmann::json::parse(as_text(m.bytes));
+            remotes[r].state = State::working;
+          } else if (m.tag == tag_result) {
+            remotes[r].jobs.pop_front();
+          } else if (m.tag == tag_failed) {
             remotes[r].state = State::failed;
             outcomes[r].failure = nlohmann::json::parse(as_text(m.bytes)).value("message", std::string("?"));
           }
         }
-        if (remotes[r].state == State::idle) {
+        if (remotes[r].state == State::working) {
           send_bytes(r, tag_stop, {});
           remotes[r].state = State::stopped;
         }
@@ -204,15 +215,19 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
           if (m->tag == tag_hello) {
             outcomes[r].report = nlohmann::json::parse(as_text(m->bytes));
             if (outcomes[r].report.contains("host")) hosts[r] = outcomes[r].report["host"].get<std::string>();
-            remotes[r].state = State::idle;
+            remotes[r].state = State::working;
           } else if (m->tag == tag_result) {
             std::size_t job = job_of(m->bytes);
+            if (remotes[r].jobs.empty() || remotes[r].jobs.front() != job)
+              throw Error("MPI: rank " + std::to_string(r) + " returned job " + std::to_string(job) +
+                          ", which it was not working on");
+            remotes[r].jobs.pop_front();
             on_result(r, job, std::span(m->bytes).subspan(8));
             last_in = Clock::now();
             outcomes[r].jobs++;
-            outcomes[r].busy_ms += std::chrono::duration<double, std::milli>(Clock::now() - remotes[r].sent).count();
+            outcomes[r].busy_ms += std::chrono::duration<double, std::milli>(last_in - remotes[r].since).count();
+            remotes[r].since = last_in;
             ++done;
-            remotes[r].state = State::idle;
           } else if (m->tag == tag_failed) {
             nlohmann::json f = nlohmann::json::parse(as_text(m->bytes));
             if (f.contains("host")) hosts[r] = f["host"].get<std::string>();
@@ -220,21 +235,22 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
             fail(r, f.value("job", -1LL), f.value("message", std::string("unknown failure")));
           }
         }
-        for (int r = 1; r < world.size; ++r) {
-          if (remotes[r].state != State::idle) continue;
-          std::size_t job;
-          {
-            std::lock_guard lock(mutex);
-            if (pending.empty()) break;
-            job = pending.front();
-            pending.pop_front();
+        for (std::size_t round = 0; round < jobs_ahead; ++round)  // one job to each rank before a second
+          for (int r = 1; r < world.size; ++r) {
+            if (remotes[r].state != State::working || remotes[r].jobs.size() > round) continue;
+            std::size_t job;
+            {
+              std::lock_guard lock(mutex);
+              if (pending.empty()) break;
+              job = pending.front();
+              pending.pop_front();
+            }
+            Clock::time_point now = Clock::now();
+            if (remotes[r].jobs.empty()) remotes[r].since = now;
+            remotes[r].jobs.push_back(job);
+            if (!first_out || now < *first_out) first_out = now;
+            send_bytes(r, tag_job, job_bytes(job));
           }
-          remotes[r].state = State::busy;
-          remotes[r].job = job;
-          remotes[r].sent = Clock::now();
-          if (!first_out || remotes[r].sent < *first_out) first_out = remotes[r].sent;
-          send_bytes(r, tag_job, job_bytes(job));
-        }
         bool queued;
         {
           std::lock_guard lock(mutex);
@@ -243,8 +259,7 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
         if (queued) wake.notify_one();
         bool anyone = local.alive;
         for (int r = 1; r < world.size; ++r)
-          anyone = anyone || remotes[r].state == State::starting || remotes[r].state == State::idle ||
-                   remotes[r].state == State::busy;
+          anyone = anyone || remotes[r].state == State::starting || remotes[r].state == State::working;
         if (!anyone) {
           throw Error("every rank failed (the warnings above say how), with " + std::to_string(total - done) +
                       " of " + std::to_string(total) + " jobs left; nothing was written");

@@ -5,12 +5,13 @@
 // Protocol (every message a byte string):
 //   worker -> 0  hello   its setup report (JSON text), after its setup
 //   0 -> worker  job     the job number (8 bytes)
-//   worker -> 0  result  the job number (8 bytes) then the job's bytes;
-//                        asks for the next job at the same time
+//   worker -> 0  result  the job number (8 bytes) then the job's bytes
+// Rank 0 keeps two jobs out per rank (the second waits in the rank's queue
+// while it runs the first), so no rank idles for a round trip between jobs.
 //   worker -> 0  failed  JSON {job (-1: during setup), host, message}
 //   0 -> worker  stop    no more jobs
 // A worker whose setup or job throws sends `failed` and takes no more jobs;
-// its job goes back to the front of the queue for the other ranks. A rank
+// its jobs go back to the front of the queue for the other ranks. A rank
 // that asks while the queue is empty but jobs are still out waits, so that
 // it can take a failed rank's job. The run fails (Error, no result) only
 // when every rank has failed with jobs left. A rank that dies without a
@@ -49,7 +50,9 @@ struct RankOutcome {
   nlohmann::json report;  // the setup report, with "host" added; null when setup failed
   std::size_t jobs = 0;   // jobs this rank returned
   std::string failure;    // "" or what failed, as the rank reported it
-  double busy_ms = 0.0;   // rank 0's view: from handing out each job to its result, summed
+  // Rank 0's view, summed over the rank's results: from the later of the
+  // job's hand-out and the previous result to this result.
+  double busy_ms = 0.0;
 };
 
 // Rank 0: every job of `order` (job numbers, in the order to hand them
