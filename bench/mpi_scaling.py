@@ -28,6 +28,7 @@ import sys
 import tempfile
 
 SUMMARY = re.compile(r"rays in ([0-9.]+) s")
+SERVED = re.compile(r"rank 0 served (\d+) tiles from other ranks in ([0-9.]+) ms")
 TILES = re.compile(r"(\d+) tiles of (\d+) px")
 RANK = re.compile(r"rank (\d+) \(host [^,]*, device .*?\): .*?(\d+) tiles: rendering ([0-9.]+) ms, handed out to returned ([0-9.]+) ms")
 
@@ -51,6 +52,8 @@ def render(rtcl, ranks, threads, tile, args, workdir):
     text = run(mpirun + base + ["--tile", str(tile)], env)
     result = {"seconds": float(SUMMARY.search(text).group(1)), "tiles": int(TILES.search(text).group(1)),
               "ranks": []}
+    served = SERVED.search(text)
+    result["serve_ms_per_tile"] = float(served.group(2)) / int(served.group(1)) if int(served.group(1)) else 0.0
     for m in RANK.finditer(text):
         result["ranks"].append({"rank": int(m.group(1)), "tiles": int(m.group(2)), "render_ms": float(m.group(3)),
                                 "round_trip_ms": float(m.group(4))})
@@ -99,8 +102,10 @@ def main():
         render_per_tile = statistics.median(r["render_ms"] / r["tiles"] for r in remote) if remote else 0.0
         comm_per_tile = statistics.median((r["round_trip_ms"] - r["render_ms"]) / r["tiles"] for r in remote) if remote else 0.0
         tiles = split[0]["tiles"]
+        serve = statistics.median(r["serve_ms_per_tile"] for r in split)
         print(f"\nN = {o.cores}: {tiles} tiles; rank 1 per tile: rendering {render_per_tile:.2f} ms, "
-              f"communication and hand-out {comm_per_tile:.3f} ms (medians)\n")
+              f"communication and hand-out {comm_per_tile:.3f} ms; rank 0's main thread per remote tile "
+              f"{serve:.4f} ms (medians)\n")
 
         sizes = [int(t) for t in o.tiles.split(",")]
         sweep = {t: [] for t in sizes}
@@ -108,8 +113,8 @@ def main():
             for t in sizes:
                 sweep[t].append(render(rtcl, o.cores, 1, t, args, work))
         print(f"| tile (px) | tiles | T (s), {o.cores} ranks | relative to the best | rank 1 ms per tile: rendering | "
-              "communication |")
-        print("|---:|---:|---:|---:|---:|---:|")
+              "communication | rank 0 serving |")
+        print("|---:|---:|---:|---:|---:|---:|---:|")
         best = min(statistics.median(r["seconds"] for r in rs) for rs in sweep.values())
         for t in sizes:
             rs = sweep[t]
@@ -117,7 +122,8 @@ def main():
             rem = [x for r in rs for x in r["ranks"] if x["rank"] == 1 and x["tiles"] > 0]
             rt = statistics.median(x["render_ms"] / x["tiles"] for x in rem) if rem else float("nan")
             ct = statistics.median((x["round_trip_ms"] - x["render_ms"]) / x["tiles"] for x in rem) if rem else float("nan")
-            print(f"| {t} | {rs[0]['tiles']} | {m:.3f} | {m / best:.2f} | {rt:.2f} | {ct:.3f} |")
+            sv = statistics.median(r["serve_ms_per_tile"] for r in rs)
+            print(f"| {t} | {rs[0]['tiles']} | {m:.3f} | {m / best:.2f} | {rt:.2f} | {ct:.3f} | {sv:.4f} |")
 
 
 if __name__ == "__main__":

@@ -114,6 +114,17 @@ class LocalWorker {
 // idle for the round trip through rank 0 between two jobs.
 constexpr std::size_t jobs_ahead = 2;
 
+// Adds the time from `start` to its end to `ms`.
+class ServeTimer {
+ public:
+  ServeTimer(double& ms, Clock::time_point start) : ms_(ms), start_(start) {}
+  ~ServeTimer() { ms_ += std::chrono::duration<double, std::milli>(Clock::now() - start_).count(); }
+
+ private:
+  double& ms_;
+  Clock::time_point start_;
+};
+
 enum class State { starting, working, failed, stopped };
 
 struct Remote {
@@ -129,6 +140,8 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
                                     FarmTimes* times) {
   std::optional<Clock::time_point> first_out;
   Clock::time_point last_in = Clock::now();
+  double serve_ms = 0.0;
+  std::size_t remote_results = 0;
   std::vector<RankOutcome> outcomes(world.size);
   std::vector<Remote> remotes(world.size);
   std::vector<std::string> hosts(world.size, "?");
@@ -208,7 +221,11 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
             progressed = true;
           }
         }
-        while (std::optional<Message> m = poll_message()) {
+        for (;;) {
+          Clock::time_point serve_start = Clock::now();
+          std::optional<Message> m = poll_message();
+          if (!m) break;
+          ServeTimer timer(serve_ms, serve_start);
           progressed = true;
           int r = m->source;
           if (r <= 0 || r >= world.size) continue;
@@ -228,6 +245,7 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
             outcomes[r].busy_ms += std::chrono::duration<double, std::milli>(last_in - remotes[r].since).count();
             remotes[r].since = last_in;
             ++done;
+            ++remote_results;
           } else if (m->tag == tag_failed) {
             nlohmann::json f = nlohmann::json::parse(as_text(m->bytes));
             if (f.contains("host")) hosts[r] = f["host"].get<std::string>();
@@ -246,6 +264,7 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
               pending.pop_front();
             }
             Clock::time_point now = Clock::now();
+            ServeTimer timer(serve_ms, now);
             if (remotes[r].jobs.empty()) remotes[r].since = now;
             remotes[r].jobs.push_back(job);
             if (!first_out || now < *first_out) first_out = now;
@@ -272,7 +291,11 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
     }
     stop_remotes();
   }
-  if (times && first_out) times->span_ms = std::chrono::duration<double, std::milli>(last_in - *first_out).count();
+  if (times && first_out) {
+    times->span_ms = std::chrono::duration<double, std::milli>(last_in - *first_out).count();
+    times->serve_ms = serve_ms;
+    times->remote_results = remote_results;
+  }
   return outcomes;
 }
 

@@ -44,6 +44,11 @@ struct FarmTimes {
   // to the last result in, in ms: the distributed work without the ranks'
   // setup before their first job.
   double span_ms = 0.0;
+  // Rank 0's main thread receiving and handling remote results (on_result
+  // included) and handing out jobs, in ms: its serial share of the work,
+  // which bounds how many ranks it can serve.
+  double serve_ms = 0.0;
+  std::size_t remote_results = 0;
 };
 
 struct RankOutcome {

@@ -232,6 +232,9 @@ void run(MpiWorld& world, const RenderOptions& o) {
                        mine.renderer ? mine.renderer->defines() : std::vector<std::string>{});
   if (broadcast)
     std::printf("rtcl render: scene %.3f MiB broadcast to %d ranks\n", scene_bytes / 1048576.0, world.size);
+  std::printf("rtcl render: rank 0 served %zu tiles from other ranks in %.1f ms (%.3f ms per tile)\n",
+              times.remote_results, times.serve_ms,
+              times.remote_results ? times.serve_ms / times.remote_results : 0.0);
   for (std::size_t r = 0; r < outcomes.size(); ++r) {
     const RankOutcome& out = outcomes[r];
     const nlohmann::json& rep = out.report;
