@@ -30,7 +30,8 @@ import tempfile
 SUMMARY = re.compile(r"rays in ([0-9.]+) s")
 SERVED = re.compile(r"rank 0 served (\d+) tiles from other ranks in ([0-9.]+) ms")
 TILES = re.compile(r"(\d+) tiles of (\d+) px")
-RANK = re.compile(r"rank (\d+) \(host [^,]*, device .*?\): .*?(\d+) tiles: rendering ([0-9.]+) ms, handed out to returned ([0-9.]+) ms")
+RANK = re.compile(r"rank (\d+) \(host [^,]*, device .*?\): .*?(\d+) tiles: rendering ([0-9.]+) ms \(slowest tile "
+                  r"([0-9.]+) ms\), handed out to returned ([0-9.]+) ms")
 
 
 def run(cmd, env):
@@ -56,7 +57,7 @@ def render(rtcl, ranks, threads, tile, args, workdir):
     result["serve_ms_per_tile"] = float(served.group(2)) / int(served.group(1)) if int(served.group(1)) else 0.0
     for m in RANK.finditer(text):
         result["ranks"].append({"rank": int(m.group(1)), "tiles": int(m.group(2)), "render_ms": float(m.group(3)),
-                                "round_trip_ms": float(m.group(4))})
+                                "slowest_ms": float(m.group(4)), "round_trip_ms": float(m.group(5))})
     return result
 
 
@@ -109,6 +110,7 @@ def main():
 
         sizes = [int(t) for t in o.tiles.split(",")]
         sweep = {t: [] for t in sizes}
+        model = {}
         for _ in range(o.repeats):
             for t in sizes:
                 sweep[t].append(render(rtcl, o.cores, 1, t, args, work))
@@ -123,7 +125,22 @@ def main():
             rt = statistics.median(x["render_ms"] / x["tiles"] for x in rem) if rem else float("nan")
             ct = statistics.median((x["round_trip_ms"] - x["render_ms"]) / x["tiles"] for x in rem) if rem else float("nan")
             sv = statistics.median(r["serve_ms_per_tile"] for r in rs)
+            slowest = statistics.median(max(x["slowest_ms"] for x in r["ranks"]) for r in rs)
+            model[t] = {"tiles": rs[0]["tiles"], "t": rt, "o": ct, "q": sv, "t_max": slowest}
             print(f"| {t} | {rs[0]['tiles']} | {m:.3f} | {m / best:.2f} | {rt:.2f} | {ct:.3f} | {sv:.4f} |")
+        # The model (README, "rtcl render under mpirun"): n tiles of mean
+        # render time t and overhead o per tile, shared by N ranks of one
+        # core each, plus the tail of the slowest tile; rank 0 serves one
+        # tile in q, so it cannot finish in less than n q.
+        print("\nModel, same image, N ranks of one core each (setup and scene broadcast not included):\n")
+        print("| tile (px) | N | predicted T (ms) | predicted efficiency | rank 0 busy serving |")
+        print("|---:|---:|---:|---:|---:|")
+        for t in sizes:
+            c = model[t]
+            for n in (2, 8, 64):
+                work = c["tiles"] * c["t"]
+                T = max(c["tiles"] * (c["t"] + c["o"]) / n + c["t_max"], c["tiles"] * c["q"])
+                print(f"| {t} | {n} | {T:.0f} | {work / (n * T):.2f} | {c['tiles'] * c['q'] / T:.1%} |")
 
 
 if __name__ == "__main__":
