@@ -154,7 +154,16 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--tile", o->tile,
                   "Under mpirun: tile side in pixels, handed out one at a time by rank 0 (a multiple of 8)")
       ->capture_default_str()
-      ->check(CLI::Range(8u, 65536u));
+      ->check(CLI::Range(8u, 65536u))
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            try {
+              if (std::stoul(text) % 8 != 0) return std::string("must be a multiple of 8 (the renderer's 8x8 ray order)");
+            } catch (const std::exception&) {  // not a number: the option's own conversion reports it
+            }
+            return std::string();
+          },
+          "multiple of 8"));
   cmd->add_option("--tile-order", o->tile_order,
                   "Under mpirun: the order tiles are handed out in: rows | shuffled (the image is the same)")
       ->capture_default_str()
