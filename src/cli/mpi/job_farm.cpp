@@ -47,7 +47,12 @@ class LocalWorker {
   LocalWorker(std::deque<std::size_t>& pending, std::mutex& mutex, std::condition_variable& wake,
               const JobSetup& setup, const JobRun& run)
       : pending_(pending), mutex_(mutex), wake_(wake), thread_([this, &setup, &run] { loop(setup, run); }) {}
-  ~LocalWorker() {
+  ~LocalWorker() { join(); }
+
+  // Stops taking jobs and waits for the thread (its setup, or the job it
+  // runs, finishes first).
+  void join() {
+    if (!thread_.joinable()) return;
     {
       std::lock_guard lock(mutex_);
       stop_ = true;
@@ -290,6 +295,13 @@ std::vector<RankOutcome> serve_jobs(const MpiWorld& world, const std::vector<std
       throw;
     }
     stop_remotes();
+    // Rank 0's setup may end after the last job: its report still counts.
+    local.join();
+    if (outcomes[0].report.is_null() && local.report) {
+      outcomes[0].report = *local.report;
+      outcomes[0].report["host"] = world.host;
+    }
+    if (local.failure && outcomes[0].failure.empty()) outcomes[0].failure = local.failure->second;
   }
   if (times && first_out) {
     times->span_ms = std::chrono::duration<double, std::milli>(last_in - *first_out).count();

@@ -155,22 +155,24 @@ void run(MpiWorld& world, const RenderOptions& o) {
 
   // --- the scene: broadcast from rank 0, or read by every rank ---
   double broadcast_ms = 0.0;
-  std::size_t scene_bytes = 0;
+  std::vector<std::byte> bytes;  // decoded in the setup below, where a failure is the rank's alone
   if (broadcast) {
-    std::vector<std::byte> bytes;
     if (root) bytes = scene_to_bytes(scene);
     check_mpi(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier");  // time the broadcast alone
     Clock::time_point start = Clock::now();
     broadcast_bytes(bytes, 0);
-    if (!root) scene = scene_from_bytes(bytes, "the scene broadcast by rank 0");
     broadcast_ms = ms_since(start);
-    scene_bytes = bytes.size();
   }
+  const std::size_t scene_bytes = bytes.size();
 
   // --- every rank's setup and tiles ---
   RankRenderer mine;
   JobSetup setup = [&]() -> nlohmann::json {
     nlohmann::json report;
+    if (broadcast && !root) {
+      scene = scene_from_bytes(bytes, "the scene broadcast by rank 0");
+      bytes = {};
+    }
     if (!broadcast && !root) {
       Clock::time_point start = Clock::now();
       scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
