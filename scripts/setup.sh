@@ -7,6 +7,8 @@ packages=(
   opencl-headers opencl-clhpp-headers ocl-icd-opencl-dev pocl-opencl-icd clinfo
   libglm-dev libopenimageio-dev openimageio-tools libassimp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev python3 python3-matplotlib
+  # distributed render and bench under mpirun (CMake option RTCL_MPI)
+  libopenmpi-dev openmpi-bin
   # fuzzing (scripts/fuzz.sh): clang with libFuzzer and the sanitizer
   # runtimes (libclang-rt-14-dev), llvm-symbolizer for readable reports
   clang libclang-rt-14-dev llvm

@@ -455,6 +455,11 @@ TEST(RenderCommand, FailuresExitNonZeroAndLeaveNoImage) {
   EXPECT_NE(r.err.find("out.unknownformat"), std::string::npos) << r.err;
   r = rtcl(dir, "render -o out.png --width 8 --accel nonsense");
   EXPECT_NE(r.status, 0);
+  r = rtcl(dir, "render -o out.png --width 8 --tile 12");  // off the 8x8 ray order
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("multiple of 8"), std::string::npos) << r.err;
+  r = rtcl(dir, "render -o out.png --width 8 --tile-order spiral");
+  EXPECT_EQ(r.status, 2);
   std::vector<std::string> entries = dir.entries();
   EXPECT_EQ(entries, (std::vector<std::string>{"bad.json", "old.png"})) << "no image and no temporary file";
 }

@@ -9,24 +9,30 @@
 
 inline float3 cam3(const float* a) { return (float3)(a[0], a[1], a[2]); }
 
-/* Rays first .. first+count-1 of the tile order, for sample `sample` of `spp`:
- * the sub-pixel position is the sampler's point in dimension RTCL_DIM_PIXEL
- * warped by the filter (shared/sampling.h); with a lens, the origin is the
- * sampler's point in RTCL_DIM_LENS on the aperture disc (concentric map) and
- * the ray passes through the pinhole ray's point at the focus distance.
- * Directions are unit length; tmin = 0, tmax = inf. Paths start at depth 0
- * with weight 1. */
+/* Rays first .. first+count-1 of the tile order of the region x0 .. x0+rw-1,
+ * y0 .. y0+rh-1 of the image (the whole image: 0, 0, width, height), for
+ * sample `sample` of `spp`: the sub-pixel position is the sampler's point in
+ * dimension RTCL_DIM_PIXEL warped by the filter (shared/sampling.h); with a
+ * lens, the origin is the sampler's point in RTCL_DIM_LENS on the aperture
+ * disc (concentric map) and the ray passes through the pinhole ray's point
+ * at the focus distance. Samples are keyed by the pixel's index in the whole
+ * image, so a pixel's rays do not depend on the region. Directions are unit
+ * length; tmin = 0, tmax = inf. Paths start at depth 0 with weight 1; their
+ * pixel is the index inside the region, row-major. */
 kernel void generate_camera_rays(global Ray* rays, global PathState* paths, global const DeviceCamera* camera,
-                                 uint first, uint count, uint sample, uint spp) {
+                                 uint first, uint count, uint sample, uint spp, uint x0, uint y0, uint rw,
+                                 uint rh) {
   uint i = get_global_id(0);
   if (i >= count) return;
   DeviceCamera c = *camera;
-  uint pixel = rtcl_tile_order_pixel(first + i, c.width, c.height);
+  uint at = rtcl_tile_order_pixel(first + i, rw, rh);
+  uint x = x0 + at % rw, y = y0 + at / rw;
+  uint pixel = y * c.width + x;
   float su, sv, dx, dy;
   rtcl_sample_2d(c.sampler, c.seed, pixel, RTCL_DIM_PIXEL, sample, spp, &su, &sv);
   rtcl_filter_offset(c.filter, su, sv, &dx, &dy);
-  float fx = (float)(pixel % c.width) + 0.5f + dx;
-  float fy = (float)(pixel / c.width) + 0.5f + dy;
+  float fx = (float)x + 0.5f + dx;
+  float fy = (float)y + 0.5f + dy;
   float3 o = cam3(c.origin);
   float3 d = cam3(c.corner) + fx * cam3(c.du) + fy * cam3(c.dv);
 #ifdef RTCL_HAS_LENS
@@ -49,7 +55,7 @@ kernel void generate_camera_rays(global Ray* rays, global PathState* paths, glob
   r.tmax = INFINITY;
   rays[i] = r;
   PathState p;
-  p.pixel = pixel;
+  p.pixel = at;
   p.depth = 0;
   p.wr = p.wg = p.wb = 1.0f;
   paths[i] = p;

@@ -169,13 +169,18 @@ inline float3 light_point(global const DeviceLight* l, float3 p, float u, float 
  *  shadow slots i*S + k   (S = P.shadow_slots) a shadow ray towards a light point and its unoccluded
  *                         contribution (flag 1), or flag 0; point lights take one slot, area lights
  *                         P.light_samples, in light order;
- *  spawn slots 2i, 2i+1   the reflected / refracted ray and path (flag = kind), or flag 0. */
+ *  spawn slots 2i, 2i+1   the reflected / refracted ray and path (flag = kind), or flag 0.
+ * Paths index pixels inside the rendered region x0 .. x0+rw-1 (rows from
+ * y0) of an image `width` pixels wide; samples are keyed by the pixel's
+ * index in the whole image, so a pixel's samples do not depend on the
+ * region. */
 kernel void shade_hits(global const Ray* rays, global const Hit* hits, global const PathState* paths, uint count,
                        global const ShadeTriangle* triangles, global const ShadeSphere* spheres,
                        global const DeviceMaterial* materials, global const DeviceLight* lights,
                        global const ShadeParams* params, global float4* radiance, global Ray* shadow_rays,
                        global float4* shadow_weight, global uint* shadow_flags, global Ray* spawn_rays,
-                       global PathState* spawn_paths, global uint* spawn_flags, uint sample) {
+                       global PathState* spawn_paths, global uint* spawn_flags, uint sample, uint x0, uint y0,
+                       uint rw, uint width) {
   uint i = get_global_id(0);
   if (i >= count) return;
   ShadeParams P = *params;
@@ -184,6 +189,7 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
   spawn_flags[2 * i + 1] = RTCL_SLOT_EMPTY;
 
   PathState path = paths[i];
+  const uint image_pixel = (y0 + path.pixel / rw) * width + x0 + path.pixel % rw;
   float3 w = (float3)(path.wr, path.wg, path.wb);
   Hit h = hits[i];
   if (h.prim < 0) {
@@ -219,7 +225,7 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
 #ifdef RTCL_HAS_AREA_LIGHTS
       if (lights[l].shape != RTCL_LIGHT_POINT) {
         float u, v;
-        rtcl_sample_2d(P.sampler, P.seed, path.pixel, dimension, sample * points + j, P.spp * points, &u, &v);
+        rtcl_sample_2d(P.sampler, P.seed, image_pixel, dimension, sample * points + j, P.spp * points, &u, &v);
         light_position = light_point(lights + l, s.p, u, v);
       }
 #endif
@@ -268,7 +274,7 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
 #ifdef RTCL_HAS_GLOSSY
     if (m->roughness > 0.0f) {
       float u, v, cos_a, sin_a, cos_phi, sin_phi;
-      rtcl_sample_2d(P.sampler, P.seed, path.pixel, rtcl_dimension_glossy(path.depth, RTCL_LIGHT_COUNT), sample,
+      rtcl_sample_2d(P.sampler, P.seed, image_pixel, rtcl_dimension_glossy(path.depth, RTCL_LIGHT_COUNT), sample,
                      P.spp, &u, &v);
       rtcl_phong_lobe(rtcl_roughness_exponent(m->roughness), u, v, &cos_a, &sin_a, &cos_phi, &sin_phi);
       float3 axis = normalize(rd), t1, t2;

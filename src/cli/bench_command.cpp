@@ -20,12 +20,14 @@
 #include <thread>
 #include <vector>
 
+#include "bench_matrix.hpp"
 #include "bench_embree.hpp"
 #include "bench_report.hpp"
 #include "bench_scenes.hpp"
 #include "cli_errors.hpp"
 #include "rtcl/cl/opencl.hpp"
 #include "commands.hpp"
+#include "distributed.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/bench/ray_sets.hpp"
 #include "rtcl/cl/device.hpp"
@@ -36,15 +38,6 @@
 namespace rtcl::cli {
 
 namespace {
-
-struct BenchOptions {
-  std::string accel, scene = "bunny", rays = "primary,shadow,diffuse", device, scenes_dir, output = "bench-results";
-  int size = 512;
-  int repeat = 5;
-  int check_rays = 256;
-  bool no_embree = false;
-  unsigned embree_threads = std::max(1u, std::thread::hardware_concurrency());
-};
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point start) {
@@ -91,6 +84,8 @@ void progress(std::size_t done, std::size_t total, const std::string& what) {
   std::fflush(stderr);
 }
 
+}  // namespace
+
 // A scene's three ray sets, generated once (on the first device) and traced
 // unchanged by every structure on every device, with brute force's answers
 // for every k-th ray.
@@ -99,6 +94,8 @@ struct SceneRays {
   std::vector<std::size_t> checked[3];  // indices of the checked rays
   std::vector<Hit> reference[3];        // brute force's hits for them
 };
+namespace {
+
 constexpr const char* kind_names[3] = {"primary", "shadow", "diffuse"};
 Query kind_query(int kind) { return kind == 1 ? Query::any : Query::closest; }
 
@@ -193,37 +190,139 @@ void measure(const Accel& accel, const SceneRays& rays, int kind, int repeat, Be
   cell.disagreeing = disagreeing(hits, rays, kind);
 }
 
-void run_bench(const BenchOptions& options) {
-  // --- every input, before any OpenCL call ---
-  BenchRun run;
-  std::vector<std::string> accels = options.accel.empty() ? default_accels() : split_spec_list(options.accel);
-  for (const std::string& a : accels) {
+}  // namespace
+
+BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) {
+  BenchMatrix m;
+  m.accels = options.accel.empty() ? default_accels() : split_spec_list(options.accel);
+  for (const std::string& a : m.accels) {
     if (a.empty()) throw UsageError("--accel " + options.accel + ": empty structure name in the list");
     parse_accel_spec(a);  // unknown structure or option: "--accel TEXT: ..."
   }
   std::string scenes_dir = options.scenes_dir.empty() ? default_scenes_dir() : options.scenes_dir;
-  std::vector<BenchSceneSpec> scenes;
-  for (const std::string& s : split_spec_list(options.scene)) scenes.push_back(parse_bench_scene(s, scenes_dir));
-  std::vector<int> kinds;
+  for (const std::string& s : split_spec_list(options.scene)) m.scenes.push_back(parse_bench_scene(s, scenes_dir));
   for (const std::string& r : split_spec_list(options.rays)) {
     auto k = std::find(std::begin(kind_names), std::end(kind_names), r);
     if (k == std::end(kind_names))
       throw UsageError("--rays " + options.rays + ": unknown ray set '" + r + "' (known: primary, shadow, diffuse)");
-    kinds.push_back(static_cast<int>(k - std::begin(kind_names)));
+    m.kinds.push_back(static_cast<int>(k - std::begin(kind_names)));
   }
-  std::error_code error;
-  std::filesystem::create_directories(options.output, error);
-  if (error) throw Error("-o " + options.output + ": cannot create the directory: " + error.message());
-  std::string json_path = options.output + "/bench.json", md_path = options.output + "/bench.md";
-  check_writable(json_path);
-  check_writable(md_path);
+  m.json_path = options.output + "/bench.json";
+  m.md_path = options.output + "/bench.md";
+  if (create_output) {
+    std::error_code error;
+    std::filesystem::create_directories(options.output, error);
+    if (error) throw Error("-o " + options.output + ": cannot create the directory: " + error.message());
+    check_writable(m.json_path);
+    check_writable(m.md_path);
+  }
   // A cache of its own, so that no other program's kernels are timed or
   // evicted; compile time shows in setup_ms / first_launch_ms only.
   if (const char* cache = std::getenv("POCL_CACHE_DIR"); !cache || !*cache) {
     std::string dir = std::filesystem::absolute(options.output + "/pocl-cache").string();
     setenv("POCL_CACHE_DIR", dir.c_str(), 1);
   }
+  return m;
+}
+
+BenchRun bench_run_header(const BenchOptions& options, const BenchMatrix& m) {
+  BenchRun run;
   run.pocl_cache_dir = std::getenv("POCL_CACHE_DIR");
+  run.rtcl_version = RTCL_VERSION;
+  run.rtcl_commit = RTCL_GIT_DESCRIBE;
+  run.host_cpu = host_cpu();
+  run.host_threads = std::max(1u, std::thread::hardware_concurrency());
+  run.started_utc = utc_now();
+  run.size = options.size;
+  run.repeat = options.repeat;
+  run.check_rays = static_cast<std::size_t>(options.check_rays);
+  run.accels = m.accels;
+  for (const BenchSceneSpec& s : m.scenes) run.scenes.push_back(s.text);
+  for (int k : m.kinds) run.ray_kinds.push_back(kind_names[k]);
+  return run;
+}
+
+BenchDevice describe_device(const Device& device) {
+  const DeviceInfo& info = device.info();
+  std::string driver = with_cl_errors([&] { return device.device().getInfo<CL_DRIVER_VERSION>(); });
+  return {info.index, info.name, info.platform, info.type, info.version, driver};
+}
+
+PreparedScene prepare_bench_scene(const Device& device, const BenchSceneSpec& spec, const BenchOptions& options) {
+  PreparedScene p;
+  p.scene = load_bench_scene(spec);
+  Clock::time_point rays_start = Clock::now();
+  p.rays = std::make_shared<SceneRays>(
+      make_rays(device, p.scene, options.size, static_cast<std::size_t>(options.check_rays)));
+  const SceneRays& rays = *p.rays;
+  p.info = {spec.text, p.scene.geometry.triangles.size(), p.scene.geometry.spheres.size(), p.scene.load_ms,
+            ms_since(rays_start), rays.sets[0].size(), rays.sets[1].size(), rays.sets[2].size()};
+  return p;
+}
+
+std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_index, const PreparedScene& scene,
+                                       const std::string& accel_name, const std::vector<int>& kinds, int repeat) {
+  Clock::time_point start = Clock::now();
+  std::unique_ptr<Accel> accel = make_accel(device, accel_name, scene.scene.geometry);
+  double setup = ms_since(start);
+  const AccelStats& stats = accel->stats();
+  std::vector<BenchCell> cells;
+  for (int k : kinds) {
+    BenchCell cell;
+    cell.device = device_index;
+    cell.scene = scene.info.name;
+    cell.accel = accel_name;
+    cell.rays = kind_names[k];
+    cell.query = kind_query(k) == Query::any ? "any" : "closest";
+    cell.build_ms = stats.build_ms;
+    cell.setup_ms = std::max(0.0, setup - stats.build_ms);
+    cell.device_bytes = stats.device_bytes;
+    cell.primitives = stats.primitive_count;
+    cell.packets = accel->rays_per_work_item(Coherence::incoherent) > 1;
+    measure(*accel, *scene.rays, k, repeat, cell);
+    cells.push_back(std::move(cell));
+  }
+  return cells;
+}
+
+void write_bench_results(const BenchRun& run, const BenchMatrix& matrix) {
+  std::string json = bench_json(run), md = bench_markdown(run);
+  write_file_atomically(matrix.json_path, std::as_bytes(std::span(json.data(), json.size())));
+  write_file_atomically(matrix.md_path, std::as_bytes(std::span(md.data(), md.size())));
+  std::fputs(md.c_str(), stdout);
+  std::printf("\nwritten: %s, %s\n", matrix.json_path.c_str(), matrix.md_path.c_str());
+}
+
+std::vector<BenchBaseline> bench_embree(const PreparedScene& scene, const std::vector<int>& kinds, int repeat,
+                                        unsigned threads) {
+  std::vector<BenchBaseline> out;
+  EmbreeBaseline embree(scene.scene.geometry, threads);
+  const SceneRays& rays = *scene.rays;
+  for (int k : kinds)
+    for (bool packets : {false, true}) {
+      if (packets && !embree.has_packets()) continue;
+      BenchBaseline baseline;
+      baseline.scene = scene.info.name;
+      baseline.rays = kind_names[k];
+      std::vector<Hit> hits = embree.measure(kind_query(k), packets, rays.sets[k], repeat, baseline);
+      if (!rays.sets[k].empty()) {
+        baseline.checked = rays.checked[k].size();
+        baseline.disagreeing = disagreeing(hits, rays, k);
+      }
+      out.push_back(std::move(baseline));
+    }
+  return out;
+}
+
+namespace {
+
+void run_bench(const BenchOptions& options) {
+  if (launcher_world_size()) {
+    refuse_ranks_without_mpi("rtcl bench");
+    if (mpi_supported()) return bench_distributed(options);
+  }
+  BenchMatrix matrix = check_bench_inputs(options, true);
+  BenchRun run = bench_run_header(options, matrix);
 
   // --- devices ---
   std::vector<DeviceInfo> infos = list_devices();
@@ -234,90 +333,32 @@ void run_bench(const BenchOptions& options) {
   } else {
     for (const DeviceInfo& info : infos) devices.push_back(Device::open(std::to_string(info.index)));
   }
-  for (const Device& device : devices) {
-    const DeviceInfo& info = device.info();
-    std::string driver = with_cl_errors([&] { return device.device().getInfo<CL_DRIVER_VERSION>(); });
-    run.devices.push_back({info.index, info.name, info.platform, info.type, info.version, driver});
-  }
-
+  for (const Device& device : devices) run.devices.push_back(describe_device(device));
   if (!options.no_embree) run.embree_version = embree_baseline_version(options.embree_threads);
-  run.rtcl_version = RTCL_VERSION;
-  run.rtcl_commit = RTCL_GIT_DESCRIBE;
-  run.host_cpu = host_cpu();
-  run.host_threads = std::max(1u, std::thread::hardware_concurrency());
-  run.started_utc = utc_now();
-  run.size = options.size;
-  run.repeat = options.repeat;
-  run.check_rays = static_cast<std::size_t>(options.check_rays);
-  run.accels = accels;
-  for (const BenchSceneSpec& s : scenes) run.scenes.push_back(s.text);
-  for (int k : kinds) run.ray_kinds.push_back(kind_names[k]);
 
-  std::size_t total = scenes.size() * devices.size() * accels.size() * kinds.size(), done = 0;
-  if (!run.embree_version.empty()) total += scenes.size() * kinds.size();
-  for (const BenchSceneSpec& scene_spec : scenes) {
+  std::size_t total = matrix.scenes.size() * (devices.size() * matrix.accels.size() + !run.embree_version.empty()),
+              done = 0;
+  for (const BenchSceneSpec& scene_spec : matrix.scenes) {
     progress(done, total, scene_spec.text + ": loading, rays and brute-force references");
-    LoadedBenchScene scene = load_bench_scene(scene_spec);
-    Clock::time_point rays_start = Clock::now();
-    SceneRays rays = make_rays(devices.front(), scene, options.size, run.check_rays);
-    run.scene_info.push_back({scene_spec.text, scene.geometry.triangles.size(), scene.geometry.spheres.size(),
-                              scene.load_ms, ms_since(rays_start), rays.sets[0].size(), rays.sets[1].size(),
-                              rays.sets[2].size()});
+    PreparedScene scene = prepare_bench_scene(devices.front(), scene_spec, options);
+    run.scene_info.push_back(scene.info);
     if (!run.embree_version.empty()) {
-      progress(done, total, scene_spec.text + " / Embree: build");
-      EmbreeBaseline embree(scene.geometry, options.embree_threads);
-      for (int k : kinds) {
-        progress(done, total, scene_spec.text + " / Embree / " + kind_names[k]);
-        for (bool packets : {false, true}) {
-          if (packets && !embree.has_packets()) continue;
-          BenchBaseline baseline;
-          baseline.scene = scene_spec.text;
-          baseline.rays = kind_names[k];
-          std::vector<Hit> hits = embree.measure(kind_query(k), packets, rays.sets[k], options.repeat, baseline);
-          if (!rays.sets[k].empty()) {
-            baseline.checked = rays.checked[k].size();
-            baseline.disagreeing = disagreeing(hits, rays, k);
-          }
-          run.embree.push_back(std::move(baseline));
-        }
-        ++done;
-      }
+      progress(done, total, scene_spec.text + " / Embree " + run.embree_version);
+      for (BenchBaseline& b : bench_embree(scene, matrix.kinds, options.repeat, options.embree_threads))
+        run.embree.push_back(std::move(b));
+      ++done;
     }
     for (std::size_t d = 0; d < devices.size(); ++d)
-      for (const std::string& accel_name : accels) {
-        progress(done, total, scene_spec.text + " / " + accel_name + " / " + run.devices[d].name + ": build");
-        Clock::time_point start = Clock::now();
-        std::unique_ptr<Accel> accel = make_accel(devices[d], accel_name, scene.geometry);
-        double setup = ms_since(start);
-        const AccelStats& stats = accel->stats();
-        for (int k : kinds) {
-          progress(done, total, scene_spec.text + " / " + accel_name + " / " + kind_names[k] + " / " +
-                                    run.devices[d].name);
-          BenchCell cell;
-          cell.device = d;
-          cell.scene = scene_spec.text;
-          cell.accel = accel_name;
-          cell.rays = kind_names[k];
-          cell.query = kind_query(k) == Query::any ? "any" : "closest";
-          cell.build_ms = stats.build_ms;
-          cell.setup_ms = std::max(0.0, setup - stats.build_ms);
-          cell.device_bytes = stats.device_bytes;
-          cell.primitives = stats.primitive_count;
-          cell.packets = accel->rays_per_work_item(Coherence::incoherent) > 1;
-          measure(*accel, rays, k, options.repeat, cell);
+      for (const std::string& accel_name : matrix.accels) {
+        progress(done, total, scene_spec.text + " / " + accel_name + " / " + run.devices[d].name);
+        for (BenchCell& cell : bench_structure(devices[d], d, scene, accel_name, matrix.kinds, options.repeat))
           run.cells.push_back(std::move(cell));
-          ++done;
-        }
+        ++done;
       }
   }
   progress(done, total, "done");
   if (isatty(2)) std::fputc('\n', stderr);
-
-  std::string json = bench_json(run), md = bench_markdown(run);
-  write_file_atomically(json_path, std::as_bytes(std::span(json.data(), json.size())));
-  write_file_atomically(md_path, std::as_bytes(std::span(md.data(), md.size())));
-  std::fputs(md.c_str(), stdout);
-  std::printf("\nwritten: %s, %s\n", json_path.c_str(), md_path.c_str());
+  write_bench_results(run, matrix);
 }
 
 }  // namespace
@@ -345,7 +386,8 @@ void add_bench_command(CLI::App& app) {
                   "rays per set (every k-th) compared with brute force; 0: none")
       ->check(CLI::Range(0, 1 << 20))
       ->capture_default_str();
-  cmd->add_flag("--no-embree", options->no_embree, "leave out the Embree baseline (present when rtcl was built with Embree)");
+  cmd->add_flag("--no-embree", options->no_embree,
+               "leave out the Embree baseline (present when rtcl was built with Embree)");
   cmd->add_option("--embree-threads", options->embree_threads, "host threads Embree traces and builds on")
       ->check(CLI::Range(1u, 1024u))
       ->capture_default_str();

@@ -9,6 +9,8 @@
 
 #include "accel_option.hpp"
 #include "commands.hpp"
+#include "distributed.hpp"
+#include "render_options.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
@@ -22,22 +24,6 @@
 namespace rtcl::cli {
 
 namespace {
-
-struct Options {
-  std::string scene;
-  std::string output = "render.png";
-  std::string accel;
-  std::string precision;  // "": the scene file's, else robust
-  std::string device;
-  std::uint32_t width = 512, height = 0;  // height 0: from the camera's aspect
-  std::uint32_t depth = 5, spp = 1;
-  float min_weight = 1e-3f;
-  std::uint32_t batch = 1u << 17;
-  std::string sampler = "stratified", filter = "box";
-  std::uint32_t seed = 0, light_samples = 1;
-  bool quiet = false;
-  bool verbose = false;
-};
 
 // A one-line bar on stderr, redrawn only when the shown percentage changes.
 class ProgressBar {
@@ -73,13 +59,36 @@ std::string join(const std::vector<std::string>& items) {
 
 double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? rays / (ms * 1e3) : 0.0; }
 
-void run(const Options& o) {
+void run(const RenderOptions& o) {
+  if (launcher_world_size()) {
+    refuse_ranks_without_mpi("rtcl render");
+    if (mpi_supported()) return render_distributed(o);
+  }
   if (!o.accel.empty()) parse_accel_spec(o.accel);  // before the scene is loaded
+  Scene scene = load_render_scene(o);
+  check_image_path(o.output);  // before the long work
+  RenderPlan plan = plan_render(o, scene);
+  Device device = Device::open(o.device);
+  require_precision(device.info(), plan.config.precision);
+  Renderer renderer(device, scene, plan.accel, plan.config);
+  ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
+  Image image = renderer.render(plan.settings, [&](double f) { bar.update(f); });
+  bar.finish();
+  write_image(o.output, image);
+  print_render_summary(o, plan, device.info().name, renderer.stats(), renderer.defines());
+}
+
+}  // namespace
+
+Scene load_render_scene(const RenderOptions& o) {
   Scene scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
   for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
-  check_image_path(o.output);  // before the long work
+  return scene;
+}
 
-  RenderSettings settings;
+RenderPlan plan_render(const RenderOptions& o, const Scene& scene) {
+  RenderPlan plan;
+  RenderSettings& settings = plan.settings;
   settings.width = o.width;
   settings.height = o.height > 0 ? o.height : default_height(scene.camera, o.width);
   settings.max_depth = o.depth;
@@ -90,26 +99,22 @@ void run(const Options& o) {
   settings.filter = *filter_from_name(o.filter);
   settings.seed = o.seed;
   settings.light_samples = o.light_samples;
+  plan.config.precision =
+      !o.precision.empty() ? parse_precision(o.precision) : scene.precision.value_or(Precision::robust);
+  plan.accel = !o.accel.empty() ? o.accel : !scene.accel.empty() ? scene.accel : default_accel();
+  return plan;
+}
 
-  AccelConfig config;
-  config.precision = !o.precision.empty() ? parse_precision(o.precision) : scene.precision.value_or(Precision::robust);
-  Device device = Device::open(o.device);
-  require_precision(device.info(), config.precision);
-  std::string accel = !o.accel.empty() ? o.accel : !scene.accel.empty() ? scene.accel : default_accel();
-  Renderer renderer(device, scene, accel, config);
-  ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
-  Image image = renderer.render(settings, [&](double f) { bar.update(f); });
-  bar.finish();
-  write_image(o.output, image);
-
-  const RenderStats& st = renderer.stats();
+void print_render_summary(const RenderOptions& o, const RenderPlan& plan, const std::string& devices,
+                          const RenderStats& st, const std::vector<std::string>& defines) {
+  const RenderSettings& settings = plan.settings;
   const RayCounts& r = st.rays;
   std::printf("rtcl render: %s (%ux%u, %u spp %s seed %u, %s filter, %u light samples, depth %u, %s, %s precision, %s): %llu camera + %llu shadow + %llu reflection + "
               "%llu refraction = %llu rays in %.3f s, %.2f Mrays/s (trace only: camera %.2f, shadow %.2f, "
               "secondary %.2f Mrays/s)\n",
               o.output.c_str(), settings.width, settings.height, settings.spp, o.sampler.c_str(), settings.seed,
-              o.filter.c_str(), settings.light_samples, settings.max_depth, accel.c_str(),
-              std::string(precision_name(config.precision)).c_str(), device.info().name.c_str(), (unsigned long long)r.camera, (unsigned long long)r.shadow,
+              o.filter.c_str(), settings.light_samples, settings.max_depth, plan.accel.c_str(),
+              std::string(precision_name(plan.config.precision)).c_str(), devices.c_str(), (unsigned long long)r.camera, (unsigned long long)r.shadow,
               (unsigned long long)r.reflection, (unsigned long long)r.refraction, (unsigned long long)r.total(),
               st.render_ms * 1e-3, mrays(r.total(), st.render_ms), mrays(r.camera, st.camera_trace_ms),
               mrays(r.shadow, st.shadow_trace_ms), mrays(r.reflection + r.refraction, st.secondary_trace_ms));
@@ -119,13 +124,11 @@ void run(const Options& o) {
                 "MiB; kernels specialised with %s\n",
                 st.generate_ms, st.camera_trace_ms, st.shade_ms, st.compact_ms, st.shadow_trace_ms,
                 st.secondary_trace_ms, st.accumulate_ms, st.generations, st.peak_queue, st.queue_bytes / 1048576.0,
-                join(renderer.defines()).c_str());
+                join(defines).c_str());
 }
 
-}  // namespace
-
 void add_render_command(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand(
       "render", "Whitted and distributed ray tracing (reflection, refraction, hard and soft shadows, "
                 "anti-aliasing, depth of field, glossy reflection) of a scene file, or of the built-in default scene "
@@ -181,6 +184,28 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--batch", o->batch, "Camera rays per wavefront (device memory vs parallelism)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 26));
+  cmd->add_option("--tile", o->tile,
+                  "Under mpirun: tile side in pixels, handed out one at a time by rank 0 (a multiple of 8)")
+      ->capture_default_str()
+      ->check(CLI::Range(8u, 65536u))
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            try {
+              if (std::stoul(text) % 8 != 0) return std::string("must be a multiple of 8 (the renderer's 8x8 ray order)");
+            } catch (const std::exception&) {  // not a number: the option's own conversion reports it
+            }
+            return std::string();
+          },
+          "multiple of 8"));
+  cmd->add_option("--tile-order", o->tile_order,
+                  "Under mpirun: the order tiles are handed out in: rows | shuffled (the image is the same)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"rows", "shuffled"}));
+  cmd->add_option("--scene-from", o->scene_from,
+                  "Under mpirun: root (rank 0 reads the scene and broadcasts it, meshes included) | each (every "
+                  "rank reads the file itself, e.g. from a shared file system)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"root", "each"}));
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
   cmd->add_flag("-v,--verbose", o->verbose, "Also print the device time of each stage and the queue sizes");
   cmd->callback([o] { run(*o); });

@@ -18,13 +18,15 @@ std::string shell_quoted(const std::string& s) {
   return q + "'";
 }
 
-CliRun run_cli(const TempDir& dir, const std::vector<std::string>& args, const std::string& env,
-               const std::string& limits) {
+namespace {
+
+CliRun run_with(const TempDir& dir, const std::vector<std::string>& args, const std::string& env,
+                const std::string& limits, const std::string& launcher) {
   if (!std::filesystem::exists(std::string(RTCL_BINARY_DIR) + "/rtcl"))
     return {-2, "",
             std::string("the rtcl binary is missing from ") + RTCL_BINARY_DIR + " (configure with RTCL_BUILD_CLI=ON)"};
   // timeout: a hang fails the test (exit 124) instead of stalling the suite.
-  std::string command = "cd " + shell_quoted(dir.path()) + " && " + limits + " " + env + " exec timeout 120 " +
+  std::string command = "cd " + shell_quoted(dir.path()) + " && " + limits + " " + env + " exec timeout 120 " + launcher + " " +
                         shell_quoted(std::string(RTCL_BINARY_DIR) + "/rtcl");
   for (const auto& a : args) command += " " + shell_quoted(a);
   // Captured outside dir, so that dir holds only what rtcl wrote.
@@ -49,6 +51,18 @@ CliRun run_cli(const TempDir& dir, const std::vector<std::string>& args, const s
   std::remove(out.c_str());
   std::remove(err.c_str());
   return run;
+}
+
+}  // namespace
+
+CliRun run_cli(const TempDir& dir, const std::vector<std::string>& args, const std::string& env,
+               const std::string& limits) {
+  return run_with(dir, args, env, limits, "");
+}
+
+CliRun run_cli_launched(const TempDir& dir, const std::string& launcher, const std::vector<std::string>& args,
+                        const std::string& env) {
+  return run_with(dir, args, env, "", launcher);
 }
 
 std::size_t count_of(const std::string& text, const std::string& fragment) {

@@ -28,6 +28,11 @@ std::string shell_quoted(const std::string& s);
 CliRun run_cli(const TempDir& dir, const std::vector<std::string>& args, const std::string& env = "",
                const std::string& limits = "");
 
+// Like run_cli, with `launcher` (e.g. "mpirun -np 2", already quoted) in
+// front of the rtcl binary.
+CliRun run_cli_launched(const TempDir& dir, const std::string& launcher, const std::vector<std::string>& args,
+                        const std::string& env = "");
+
 std::size_t count_of(const std::string& text, const std::string& fragment);
 
 // A failed run: exit `status` (1: bad input, 2: usage), exactly one

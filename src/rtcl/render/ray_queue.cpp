@@ -92,7 +92,8 @@ void RayQueue::specialise_generation(const std::vector<std::string>& defines) {
 }
 
 cl::Event RayQueue::generate_camera_rays(const cl::Buffer& camera, std::uint32_t first, std::uint32_t count,
-                                         std::uint32_t sample, std::uint32_t spp,
+                                         std::uint32_t sample, std::uint32_t spp, std::uint32_t x0,
+                                         std::uint32_t y0, std::uint32_t rw, std::uint32_t rh,
                                          const std::vector<cl::Event>& wait) {
   rays_.reserve(device_, count);
   paths_.reserve(device_, count);
@@ -105,6 +106,10 @@ cl::Event RayQueue::generate_camera_rays(const cl::Buffer& camera, std::uint32_t
     generate_.setArg(4, static_cast<cl_uint>(count));
     generate_.setArg(5, static_cast<cl_uint>(sample));
     generate_.setArg(6, static_cast<cl_uint>(spp));
+    generate_.setArg(7, static_cast<cl_uint>(x0));
+    generate_.setArg(8, static_cast<cl_uint>(y0));
+    generate_.setArg(9, static_cast<cl_uint>(rw));
+    generate_.setArg(10, static_cast<cl_uint>(rh));
     return launch(device_, generate_, std::max<std::uint32_t>(count, 1), wait);
   });
 }

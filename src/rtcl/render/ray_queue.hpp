@@ -71,9 +71,12 @@ class RayQueue {
   void specialise_generation(const std::vector<std::string>& defines);
 
   // Fills the queue with camera rays first .. first + count - 1 of the
-  // screen-tile order for sample `sample` of `spp` (camera: a DeviceCamera).
+  // screen-tile order of the image region (x0, y0, rw, rh) for sample
+  // `sample` of `spp` (camera: a DeviceCamera); paths carry the pixel's
+  // row-major index inside the region.
   cl::Event generate_camera_rays(const cl::Buffer& camera, std::uint32_t first, std::uint32_t count,
-                                 std::uint32_t sample, std::uint32_t spp, const std::vector<cl::Event>& wait);
+                                 std::uint32_t sample, std::uint32_t spp, std::uint32_t x0, std::uint32_t y0,
+                                 std::uint32_t rw, std::uint32_t rh, const std::vector<cl::Event>& wait);
 
   // Replaces the contents with these rays and paths (same length).
   void assign(const std::vector<Ray>& rays, const std::vector<PathState>& paths);

@@ -54,6 +54,16 @@ std::uint32_t shadow_slots_per_ray(const Scene& scene, std::uint32_t light_sampl
   return slots;
 }
 
+ImageRegion checked_region(const RenderSettings& s, const ImageRegion& r) {
+  if (r.width == 0 && r.height == 0 && r.x0 == 0 && r.y0 == 0) return ImageRegion{0, 0, s.width, s.height};
+  if (r.width == 0 || r.height == 0 || r.x0 >= s.width || r.y0 >= s.height || r.width > s.width - r.x0 ||
+      r.height > s.height - r.y0)
+    throw Error("image region " + std::to_string(r.width) + "x" + std::to_string(r.height) + " at (" +
+                std::to_string(r.x0) + ", " + std::to_string(r.y0) + "): must be non-empty and inside the " +
+                std::to_string(s.width) + "x" + std::to_string(s.height) + " image");
+  return r;
+}
+
 }  // namespace
 
 struct Renderer::State {
@@ -66,6 +76,7 @@ struct Renderer::State {
 
   // Per render.
   RenderSettings settings;
+  ImageRegion region;
   cl::Buffer camera, params, framebuffer, totals;
   // Per generation: queue -> hits -> radiance + slots -> next queue + shadow queue.
   RayQueue queue, next;
@@ -108,12 +119,13 @@ const Accel& Renderer::accel() const { return *s_->accel; }
 const std::vector<std::string>& Renderer::defines() const { return s_->shading.defines; }
 
 // Per render: camera, shading constants, a cleared framebuffer.
-void Renderer::prepare(const RenderSettings& settings) {
+void Renderer::prepare(const RenderSettings& settings, const ImageRegion& region) {
   check_settings(settings);
   State& s = *s_;
   s.settings = settings;
+  s.region = checked_region(settings, region);
   s.stats = RenderStats{};
-  const std::uint32_t pixels = settings.width * settings.height;
+  const std::uint32_t pixels = s.region.width * s.region.height;
   CameraFrame frame = camera_frame(s.scene.camera, settings.width, settings.height);
   DeviceCamera camera{};
   store(camera.origin, frame.origin);
@@ -155,10 +167,14 @@ void Renderer::prepare(const RenderSettings& settings) {
 }
 
 Image Renderer::render(const RenderSettings& settings, const RenderProgress& progress) {
+  return render(settings, ImageRegion{}, progress);
+}
+
+Image Renderer::render(const RenderSettings& settings, const ImageRegion& region, const RenderProgress& progress) {
   auto start = std::chrono::steady_clock::now();
-  prepare(settings);
+  prepare(settings, region);
   State& s = *s_;
-  const std::uint32_t pixels = settings.width * settings.height;
+  const std::uint32_t pixels = s.region.width * s.region.height;
   const double total_work = double(pixels) * settings.spp;
   for (std::uint32_t sample = 0; sample < settings.spp; ++sample)
     for (std::uint32_t first = 0; first < pixels; first += settings.batch_pixels) {
@@ -186,8 +202,8 @@ Image Renderer::render(const RenderSettings& settings, const RenderProgress& pro
     s.device.queue().enqueueReadBuffer(s.framebuffer, CL_TRUE, 0, sums.size() * RTCL_RADIANCE_BYTES, sums.data(), wait_list(s.last));
   });
   Image image;
-  image.width = settings.width;
-  image.height = settings.height;
+  image.width = s.region.width;
+  image.height = s.region.height;
   image.rgb.resize(std::size_t(pixels) * 3);
   const float inv = 1.0f / static_cast<float>(settings.spp);
   for (std::size_t p = 0; p < pixels; ++p)
@@ -202,7 +218,7 @@ Image Renderer::render(const RenderSettings& settings, const RenderProgress& pro
 }
 
 std::vector<std::vector<TreeRay>> Renderer::ray_tree(const Ray& ray, const RenderSettings& settings) {
-  prepare(settings);
+  prepare(settings, ImageRegion{});
   State& s = *s_;
   s.sample = 0;
   std::vector<std::vector<TreeRay>> tree;
@@ -227,7 +243,9 @@ std::vector<std::vector<TreeRay>> Renderer::ray_tree(const Ray& ray, const Rende
 // generate: camera rays of one batch, in screen-tile order.
 void Renderer::generate(std::uint32_t first, std::uint32_t count, std::uint32_t sample) {
   State& s = *s_;
-  cl::Event e = s.queue.generate_camera_rays(s.camera, first, count, sample, s.settings.spp, s.last);
+  const ImageRegion& r = s.region;
+  cl::Event e = s.queue.generate_camera_rays(s.camera, first, count, sample, s.settings.spp, r.x0, r.y0, r.width,
+                                             r.height, s.last);
   s.generates.push_back(e);
   s.last = {e};
   s.stats.rays.camera += count;
@@ -275,6 +293,10 @@ void Renderer::shade() {
     k.setArg(a++, s.spawn.paths.buffer());
     k.setArg(a++, s.spawn.flags.buffer());
     k.setArg(a++, static_cast<cl_uint>(s.sample));
+    k.setArg(a++, static_cast<cl_uint>(s.region.x0));
+    k.setArg(a++, static_cast<cl_uint>(s.region.y0));
+    k.setArg(a++, static_cast<cl_uint>(s.region.width));
+    k.setArg(a++, static_cast<cl_uint>(s.settings.width));
     cl::Event e = launch(s.device, k, n, s.last);
     s.shades.push_back(e);
     s.last = {e};

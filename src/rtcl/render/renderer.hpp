@@ -55,6 +55,12 @@ struct RenderSettings {
   std::uint32_t batch_pixels = 1u << 17;
 };
 
+// A rectangle of the image, in pixels from the top left; width or height 0:
+// the whole image.
+struct ImageRegion {
+  std::uint32_t x0 = 0, y0 = 0, width = 0, height = 0;
+};
+
 struct RayCounts {
   std::uint64_t camera = 0, shadow = 0, reflection = 0, refraction = 0;
   std::uint64_t total() const { return camera + shadow + reflection + refraction; }
@@ -97,6 +103,16 @@ class Renderer {
   // Renders the scene; deterministic for a given device and settings.
   // Throws Error naming the setting for an invalid one.
   Image render(const RenderSettings& settings, const RenderProgress& progress = {});
+  // One region of that image, as an image of the region's size. Every pixel
+  // starts from the same camera rays as in the whole-image render, its
+  // secondary rays keep their relative queue order, and its radiance is
+  // summed in the same order; a region whose x0 and y0 are multiples of
+  // RTCL_TILE (8) also traces its camera rays in the same packets of 8. Such
+  // regions give the whole image's pixels bit for bit, in any order and any
+  // split, as long as a ray's hit does not depend on the rays that share its
+  // packet (tests/render_region_test.cpp). Throws Error naming the region
+  // when it is empty or leaves the image.
+  Image render(const RenderSettings& settings, const ImageRegion& region, const RenderProgress& progress = {});
 
   // The ray tree of one ray, for inspection and tests: generation 0 is
   // `ray` (weight 1, depth 0), generation g + 1 the reflected and refracted
@@ -113,7 +129,7 @@ class Renderer {
   struct State;
   std::unique_ptr<State> s_;
 
-  void prepare(const RenderSettings& settings);
+  void prepare(const RenderSettings& settings, const ImageRegion& region);
   void generate(std::uint32_t first, std::uint32_t count, std::uint32_t sample);
   void trace(bool camera_rays);
   void shade();

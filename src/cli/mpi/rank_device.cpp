@@ -1,0 +1,16 @@
+#include "mpi/rank_device.hpp"
+
+#include <vector>
+
+#include "rtcl/error.hpp"
+
+namespace rtcl::cli {
+
+Device open_rank_device(const std::string& selector, int local_rank) {
+  if (!selector.empty()) return Device::open(selector);
+  std::vector<DeviceInfo> infos = list_devices();
+  if (infos.empty()) throw Error("no OpenCL device found (`rtcl devices` lists them)");
+  return Device::open(std::to_string(infos[static_cast<std::size_t>(local_rank) % infos.size()].index));
+}
+
+}  // namespace rtcl::cli

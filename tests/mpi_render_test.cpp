@@ -1,0 +1,152 @@
+// `mpirun -np N rtcl render` on localhost (N = 2, 3) against the
+// single-process `rtcl render` of the same scene and settings: the same
+// pixels bit for bit (EXR keeps the floats), for every tile size and order;
+// a rank that fails mid-render is reported and its tile rendered by another;
+// a killed rank or a run no rank can finish gives an error and no file.
+// Built only with MPI (RTCL_HAVE_MPI); RTCL_MPIEXEC is CMake's MPIEXEC.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "rtcl/render/image.hpp"
+#include "support/cli_run.hpp"
+#include "support/temp_dir.hpp"
+
+namespace rtcl::test {
+namespace {
+
+// The ranks' environment: `extra`, and under AddressSanitizer (scripts/
+// test.sh --sanitize) leak checking off for them: Open MPI 4.1 leaks from
+// components it unloads at MPI_Finalize, so LeakSanitizer's reports carry
+// no library name to suppress them by (a two-rank MPI_Bcast program built
+// with -fsanitize=address aborts at exit). Memory errors are still caught.
+std::string rank_env(const std::string& extra = "") {
+  std::string env = extra;
+  if (const char* asan = std::getenv("ASAN_OPTIONS"); asan && *asan)
+    env += " ASAN_OPTIONS=" + shell_quoted(std::string(asan) + ":detect_leaks=0");
+  return env;
+}
+
+// As root (CI containers) mpirun needs --allow-run-as-root; --oversubscribe
+// lets 3 ranks share 2 cores.
+std::string mpirun(int ranks) {
+  return shell_quoted(RTCL_MPIEXEC) + " --allow-run-as-root --oversubscribe -np " + std::to_string(ranks);
+}
+
+// Small on purpose: spp 4 and depth 5 over the default scene's glass
+// sphere, about a second per run.
+std::vector<std::string> render_args(const std::string& output) {
+  return {"render", "-q", "--width", "64", "--height", "48", "--spp", "4", "-o", output};
+}
+
+std::vector<std::string> with(std::vector<std::string> args, const std::vector<std::string>& more) {
+  args.insert(args.end(), more.begin(), more.end());
+  return args;
+}
+
+// For the fault tests: enough work (192 tiles of 8 px, about 3 s on one
+// rank) that every rank is set up and takes tiles before the image is done.
+std::vector<std::string> long_render_args(const std::string& output) {
+  return {"render", "-q", "--width", "128", "--height", "96", "--spp", "16", "--tile", "8", "-o", output};
+}
+
+Image single_process(const TempDir& dir, const std::vector<std::string>& args) {
+  CliRun run = run_cli(dir, args);
+  EXPECT_EQ(run.status, 0) << run.err;
+  return read_image(dir.file(args.back()));
+}
+
+Image single_process(const TempDir& dir) {
+  CliRun run = run_cli(dir, render_args("single.exr"));
+  EXPECT_EQ(run.status, 0) << run.err;
+  return read_image(dir.file("single.exr"));
+}
+
+void expect_same_pixels(const Image& a, const Image& b, const std::string& what) {
+  ASSERT_EQ(a.width, b.width) << what;
+  ASSERT_EQ(a.height, b.height) << what;
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) differing += a.rgb[i] != b.rgb[i];
+  EXPECT_EQ(differing, 0u) << what << ": " << differing << " of " << a.rgb.size() << " values differ";
+}
+
+TEST(MpiRender, TwoAndThreeRanksGiveTheSingleProcessImage) {
+  TempDir dir;
+  Image reference = single_process(dir);
+  for (int ranks : {2, 3}) {
+    std::string out = "mpi" + std::to_string(ranks) + ".exr";
+    CliRun run = run_cli_launched(dir, mpirun(ranks), with(render_args(out), {"--tile", "16"}), rank_env());
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_NE(run.out.find(std::to_string(ranks) + " MPI ranks"), std::string::npos) << run.out;
+    for (int r = 0; r < ranks; ++r)
+      EXPECT_NE(run.out.find("rank " + std::to_string(r) + " (host"), std::string::npos) << run.out;
+    expect_same_pixels(read_image(dir.file(out)), reference, std::to_string(ranks) + " ranks");
+  }
+}
+
+TEST(MpiRender, TileSizeOrderAndSceneSourceDoNotChangeTheImage) {
+  TempDir dir;
+  Image reference = single_process(dir);
+  const std::vector<std::vector<std::string>> variants = {
+      {"--tile", "8", "--tile-order", "shuffled"},
+      {"--tile", "24", "--tile-order", "rows"},
+      {"--tile", "128"},  // one tile larger than the image
+      {"--tile", "16", "--tile-order", "shuffled", "--scene-from", "each"}};
+  for (const auto& variant : variants) {
+    std::string what;
+    for (const auto& v : variant) what += v + " ";
+    CliRun run = run_cli_launched(dir, mpirun(3), with(render_args("tiled.exr"), variant), rank_env());
+    ASSERT_EQ(run.status, 0) << what << run.err;
+    expect_same_pixels(read_image(dir.file("tiled.exr")), reference, what);
+  }
+}
+
+TEST(MpiRender, ARankFailingMidRenderIsNamedAndItsTileRenderedElsewhere) {
+  TempDir dir;
+  Image reference = single_process(dir, long_render_args("single.exr"));
+  // Rank 2 renders its first tile, then fails instead of returning it.
+  CliRun run = run_cli_launched(dir, mpirun(3), long_render_args("faulty.exr"), rank_env("RTCL_MPI_FAULT=error:2"));
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("rtcl: warning: rank 2 (host "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("injected fault"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("the job goes to another rank"), std::string::npos) << run.err;
+  EXPECT_NE(run.out.find("1 failed"), std::string::npos) << run.out;
+  expect_same_pixels(read_image(dir.file("faulty.exr")), reference, "with rank 2 failing");
+}
+
+TEST(MpiRender, AKilledRankEndsTheJobWithAnErrorAndNoOutputFile) {
+  TempDir dir;
+  // Rank 2 sends itself SIGKILL on its first tile: Open MPI's mpirun ends
+  // the job, naming the rank, before rank 0 has written anything.
+  CliRun run = run_cli_launched(dir, mpirun(3), long_render_args("killed.exr"), rank_env("RTCL_MPI_FAULT=kill:2"));
+  EXPECT_NE(run.status, 0) << run.err;
+  EXPECT_NE(run.err.find("rank 2"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("signal 9"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("killed.exr")));
+  for (const auto& name : dir.entries()) EXPECT_EQ(name.find(".tmp-"), std::string::npos) << "left behind: " << name;
+}
+
+TEST(MpiRender, NoRankAbleToRenderIsOneClearErrorAndNoOutputFile) {
+  TempDir dir;
+  CliRun run = run_cli_launched(dir, mpirun(2), with(render_args("none.exr"), {"--device", "no-such-device"}), rank_env());
+  EXPECT_EQ(run.status, 1) << run.err;
+  EXPECT_EQ(count_of(run.err, "rtcl: error:"), 1u) << run.err;
+  EXPECT_NE(run.err.find("every rank failed"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("no-such-device"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("none.exr")));
+}
+
+TEST(MpiRender, BadInputOnRankZeroIsOneErrorForTheWholeJob) {
+  TempDir dir;
+  CliRun run = run_cli_launched(dir, mpirun(2), {"render", "-q", "missing.json", "-o", "x.png"}, rank_env());
+  EXPECT_EQ(run.status, 1) << run.err;
+  EXPECT_EQ(count_of(run.err, "rtcl: error:"), 1u) << run.err;
+  EXPECT_NE(run.err.find("missing.json"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.png")));
+}
+
+}  // namespace
+}  // namespace rtcl::test
