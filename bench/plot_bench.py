@@ -56,8 +56,9 @@ def load(paths):
     return cells
 
 
-def plot_rates(cells, path):
-    cells = [c for c in cells if not c.get("baseline")]
+def plot_panels(cells, path, value, ylabel, title, one=False):
+    """Bars per structure per scene, one panel per (device, ray set);
+    value(cell) -> (median, low error, high error)."""
     order = {"primary": 0, "shadow": 1, "diffuse": 2}
     panels = sorted({(c["device_label"], c["rays"]) for c in cells}, key=lambda p: (p[0], order.get(p[1], 3), p[1]))
     fig, axes = plt.subplots(len(panels), 1, figsize=(10, 3.2 * len(panels)), squeeze=False)
@@ -71,20 +72,30 @@ def plot_rates(cells, path):
             for s, scene in enumerate(scenes):
                 for c in mine:
                     if c["scene"] == scene and c["accel"] == accel:
-                        r = c["mrays_per_s"]["kernel"]
+                        y, low, high = value(c)
                         xs.append(s + (a - (len(accels) - 1) / 2) * width)
-                        ys.append(r["median"])
-                        lo.append(r["median"] - r["min"])
-                        hi.append(r["max"] - r["median"])
+                        ys.append(y)
+                        lo.append(low)
+                        hi.append(high)
             ax.bar(xs, ys, width, yerr=[lo, hi], capsize=2, label=accel)
+        if one:
+            ax.axhline(1.0, color="black", linewidth=0.8)
         ax.set_xticks(range(len(scenes)))
         ax.set_xticklabels(scenes, fontsize=8)
-        ax.set_ylabel("Mrays/s (kernel)")
-        ax.set_title(f"{rays} rays, {device}", fontsize=9)
+        ax.set_ylabel(ylabel)
+        ax.set_title(f"{rays} rays, {device}{title}", fontsize=9)
         ax.legend(fontsize=7, ncol=4)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     print(f"written: {path}")
+
+
+def plot_rates(cells, path):
+    def rate(c):
+        r = c["mrays_per_s"]["kernel"]
+        return r["median"], r["median"] - r["min"], r["max"] - r["median"]
+
+    plot_panels([c for c in cells if not c.get("baseline")], path, rate, "Mrays/s (kernel)", "")
 
 
 def plot_build(cells, path):
@@ -109,33 +120,9 @@ def plot_build(cells, path):
 
 def plot_embree(cells, path):
     cells = [c for c in cells if not c.get("baseline") and c.get("embree")]
-    if not cells:
-        return
-    order = {"primary": 0, "shadow": 1, "diffuse": 2}
-    panels = sorted({(c["device_label"], c["rays"]) for c in cells}, key=lambda p: (p[0], order.get(p[1], 3), p[1]))
-    fig, axes = plt.subplots(len(panels), 1, figsize=(10, 3.2 * len(panels)), squeeze=False)
-    for ax, (device, rays) in zip(axes[:, 0], panels):
-        mine = [c for c in cells if c["device_label"] == device and c["rays"] == rays]
-        scenes = list(dict.fromkeys(c["scene"] for c in mine))
-        accels = list(dict.fromkeys(c["accel"] for c in mine))
-        width = 0.8 / max(1, len(accels))
-        for a, accel in enumerate(accels):
-            xs, ys = [], []
-            for s, scene in enumerate(scenes):
-                for c in mine:
-                    if c["scene"] == scene and c["accel"] == accel:
-                        xs.append(s + (a - (len(accels) - 1) / 2) * width)
-                        ys.append(c["embree"]["ratio"])
-            ax.bar(xs, ys, width, label=accel)
-        ax.axhline(1.0, color="black", linewidth=0.8)
-        ax.set_xticks(range(len(scenes)))
-        ax.set_xticklabels(scenes, fontsize=8)
-        ax.set_ylabel("rtcl / Embree")
-        ax.set_title(f"{rays} rays, {device}, against Embree on the host", fontsize=9)
-        ax.legend(fontsize=7, ncol=4)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    print(f"written: {path}")
+    if cells:
+        plot_panels(cells, path, lambda c: (c["embree"]["ratio"], 0.0, 0.0), "rtcl / Embree",
+                    ", against Embree on the host", one=True)
 
 
 def main():
