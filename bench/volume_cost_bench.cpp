@@ -16,19 +16,28 @@
 namespace rtcl::bench {
 namespace {
 
+// Child `lane`'s box of a node as centre and half extent (both 0 for an
+// empty slot); returns whether the slot is empty.
+bool lane_box(const Bvh8Node& node, int lane, glm::vec3* mid, glm::vec3* half) {
+  const auto& b = node.bounds;
+  bool empty = node.child[lane] == RTCL_CHILD_EMPTY;
+  glm::vec3 lo(b[0][lane], b[1][lane], b[2][lane]), hi(b[3][lane], b[4][lane], b[5][lane]);
+  *mid = empty ? glm::vec3(0.0f) : 0.5f * (lo + hi);
+  *half = empty ? glm::vec3(0.0f) : 0.5f * (hi - lo);
+  return empty;
+}
+
 // Spheres for timing only: each lane's box's circumscribed sphere.
 std::vector<Bvh8Spheres> box_spheres(const std::vector<Bvh8Node>& nodes) {
   std::vector<Bvh8Spheres> out(nodes.size());
   for (std::size_t n = 0; n < nodes.size(); ++n)
     for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
-      const auto& b = nodes[n].bounds;
-      bool empty = nodes[n].child[lane] == RTCL_CHILD_EMPTY;
-      glm::vec3 lo(b[0][lane], b[1][lane], b[2][lane]), hi(b[3][lane], b[4][lane], b[5][lane]);
-      glm::vec3 c = empty ? glm::vec3(0.0f) : 0.5f * (lo + hi);
+      glm::vec3 c, half;
+      bool empty = lane_box(nodes[n], lane, &c, &half);
       out[n].cx[lane] = c.x;
       out[n].cy[lane] = c.y;
       out[n].cz[lane] = c.z;
-      out[n].r[lane] = empty ? -1.0f : 0.5f * glm::length(hi - lo);
+      out[n].r[lane] = empty ? -1.0f : glm::length(half);
     }
   return out;
 }
@@ -42,10 +51,8 @@ std::vector<Bvh8Kdop> box_kdops(const std::vector<Bvh8Node>& nodes) {
   std::vector<Bvh8Kdop> out(nodes.size());
   for (std::size_t n = 0; n < nodes.size(); ++n)
     for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
-      const auto& b = nodes[n].bounds;
-      bool empty = nodes[n].child[lane] == RTCL_CHILD_EMPTY;
-      glm::vec3 lo(b[0][lane], b[1][lane], b[2][lane]), hi(b[3][lane], b[4][lane], b[5][lane]);
-      glm::vec3 mid = empty ? glm::vec3(0.0f) : 0.5f * (lo + hi), half = empty ? glm::vec3(0.0f) : 0.5f * (hi - lo);
+      glm::vec3 mid, half;
+      lane_box(nodes[n], lane, &mid, &half);
       for (int j = 0; j < RTCL_KDOP_FILTER_SLABS; ++j) {
         float centre = glm::dot(dirs[j], mid), extent = glm::dot(glm::abs(dirs[j]), half);
         out[n].d_near[j][lane] = centre - extent;
@@ -61,10 +68,8 @@ std::vector<Bvh8Obb> box_obbs(const std::vector<Bvh8Node>& nodes) {
   std::vector<Bvh8Obb> out(nodes.size());
   for (std::size_t n = 0; n < nodes.size(); ++n)
     for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
-      const auto& b = nodes[n].bounds;
-      bool empty = nodes[n].child[lane] == RTCL_CHILD_EMPTY;
-      glm::vec3 lo(b[0][lane], b[1][lane], b[2][lane]), hi(b[3][lane], b[4][lane], b[5][lane]);
-      glm::vec3 mid = empty ? glm::vec3(0.0f) : 0.5f * (lo + hi), half = empty ? glm::vec3(0.0f) : 0.5f * (hi - lo);
+      glm::vec3 mid, half;
+      lane_box(nodes[n], lane, &mid, &half);
       for (int i = 0; i < 3; ++i) {
         for (int k = 0; k < 3; ++k) out[n].axis[3 * i + k][lane] = axes[i][k];
         float centre = glm::dot(axes[i], mid), extent = glm::dot(glm::abs(axes[i]), half);

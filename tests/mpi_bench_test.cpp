@@ -19,13 +19,8 @@
 namespace rtcl::test {
 namespace {
 
-// Leak checking and alternate signal stacks off for the ranks under ASan:
-// see mpi_render_test.cpp.
 std::string rank_env() {
-  std::string env = std::string("RTCL_SCENES_DIR=") + shell_quoted(RTCL_SCENE_DIR);
-  if (const char* asan = std::getenv("ASAN_OPTIONS"); asan && *asan)
-    env += " ASAN_OPTIONS=" + shell_quoted(std::string(asan) + ":detect_leaks=0:use_sigaltstack=0");
-  return env;
+  return mpi_rank_env(std::string("RTCL_SCENES_DIR=") + shell_quoted(RTCL_SCENE_DIR));
 }
 
 using Key = std::tuple<std::string, std::string, std::string>;

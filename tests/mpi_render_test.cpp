@@ -18,21 +18,6 @@
 namespace rtcl::test {
 namespace {
 
-// The ranks' environment: `extra`, and under AddressSanitizer (scripts/
-// test.sh --sanitize) leak checking off for them: Open MPI 4.1 leaks from
-// components it unloads at MPI_Finalize, so LeakSanitizer's reports carry
-// no library name to suppress them by (a two-rank MPI_Bcast program built
-// with -fsanitize=address aborts at exit), and no alternate signal stacks:
-// with them, a rank's exiting Open MPI thread fails in AddressSanitizer's
-// own unmapping of its signal stack ("failed to deallocate ... unable to
-// unmap", UnsetAlternateSignalStack), before any test code runs. Memory
-// errors are still caught.
-std::string rank_env(const std::string& extra = "") {
-  std::string env = extra;
-  if (const char* asan = std::getenv("ASAN_OPTIONS"); asan && *asan)
-    env += " ASAN_OPTIONS=" + shell_quoted(std::string(asan) + ":detect_leaks=0:use_sigaltstack=0");
-  return env;
-}
 
 // As root (CI containers) mpirun needs --allow-run-as-root; --oversubscribe
 // lets 3 ranks share 2 cores.
@@ -82,7 +67,7 @@ TEST(MpiRender, TwoAndThreeRanksGiveTheSingleProcessImage) {
   Image reference = single_process(dir);
   for (int ranks : {2, 3}) {
     std::string out = "mpi" + std::to_string(ranks) + ".exr";
-    CliRun run = run_cli_launched(dir, mpirun(ranks), with(render_args(out), {"--tile", "16"}), rank_env());
+    CliRun run = run_cli_launched(dir, mpirun(ranks), with(render_args(out), {"--tile", "16"}), mpi_rank_env());
     ASSERT_EQ(run.status, 0) << run.err;
     EXPECT_NE(run.out.find(std::to_string(ranks) + " MPI ranks"), std::string::npos) << run.out;
     for (int r = 0; r < ranks; ++r)
@@ -102,7 +87,7 @@ TEST(MpiRender, TileSizeOrderAndSceneSourceDoNotChangeTheImage) {
   for (const auto& variant : variants) {
     std::string what;
     for (const auto& v : variant) what += v + " ";
-    CliRun run = run_cli_launched(dir, mpirun(3), with(render_args("tiled.exr"), variant), rank_env());
+    CliRun run = run_cli_launched(dir, mpirun(3), with(render_args("tiled.exr"), variant), mpi_rank_env());
     ASSERT_EQ(run.status, 0) << what << run.err;
     expect_same_pixels(read_image(dir.file("tiled.exr")), reference, what);
   }
@@ -112,7 +97,7 @@ TEST(MpiRender, ARankFailingMidRenderIsNamedAndItsTileRenderedElsewhere) {
   TempDir dir;
   Image reference = single_process(dir, long_render_args("single.exr"));
   // Rank 2 renders its first tile, then fails instead of returning it.
-  CliRun run = run_cli_launched(dir, mpirun(3), long_render_args("faulty.exr"), rank_env("RTCL_MPI_FAULT=error:2"));
+  CliRun run = run_cli_launched(dir, mpirun(3), long_render_args("faulty.exr"), mpi_rank_env("RTCL_MPI_FAULT=error:2"));
   ASSERT_EQ(run.status, 0) << run.err;
   EXPECT_NE(run.err.find("rtcl: warning: rank 2 (host "), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("injected fault"), std::string::npos) << run.err;
@@ -125,7 +110,7 @@ TEST(MpiRender, AKilledRankEndsTheJobWithAnErrorAndNoOutputFile) {
   TempDir dir;
   // Rank 2 sends itself SIGKILL on its first tile: Open MPI's mpirun ends
   // the job, naming the rank, before rank 0 has written anything.
-  CliRun run = run_cli_launched(dir, mpirun(3), long_render_args("killed.exr"), rank_env("RTCL_MPI_FAULT=kill:2"));
+  CliRun run = run_cli_launched(dir, mpirun(3), long_render_args("killed.exr"), mpi_rank_env("RTCL_MPI_FAULT=kill:2"));
   EXPECT_NE(run.status, 0) << run.err;
   EXPECT_NE(run.err.find("rank 2"), std::string::npos) << run.err;
   EXPECT_NE(run.err.find("signal 9"), std::string::npos) << run.err;
@@ -135,7 +120,7 @@ TEST(MpiRender, AKilledRankEndsTheJobWithAnErrorAndNoOutputFile) {
 
 TEST(MpiRender, NoRankAbleToRenderIsOneClearErrorAndNoOutputFile) {
   TempDir dir;
-  CliRun run = run_cli_launched(dir, mpirun(2), with(render_args("none.exr"), {"--device", "no-such-device"}), rank_env());
+  CliRun run = run_cli_launched(dir, mpirun(2), with(render_args("none.exr"), {"--device", "no-such-device"}), mpi_rank_env());
   EXPECT_EQ(run.status, 1) << run.err;
   EXPECT_EQ(count_of(run.err, "rtcl: error:"), 1u) << run.err;
   EXPECT_NE(run.err.find("every rank failed"), std::string::npos) << run.err;
@@ -145,7 +130,7 @@ TEST(MpiRender, NoRankAbleToRenderIsOneClearErrorAndNoOutputFile) {
 
 TEST(MpiRender, BadInputOnRankZeroIsOneErrorForTheWholeJob) {
   TempDir dir;
-  CliRun run = run_cli_launched(dir, mpirun(2), {"render", "-q", "missing.json", "-o", "x.png"}, rank_env());
+  CliRun run = run_cli_launched(dir, mpirun(2), {"render", "-q", "missing.json", "-o", "x.png"}, mpi_rank_env());
   EXPECT_EQ(run.status, 1) << run.err;
   EXPECT_EQ(count_of(run.err, "rtcl: error:"), 1u) << run.err;
   EXPECT_NE(run.err.find("missing.json"), std::string::npos) << run.err;

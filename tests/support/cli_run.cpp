@@ -88,4 +88,11 @@ void expect_usage_error(const CliRun& run, const std::string& fragment) {
   EXPECT_NE(run.err.find("--help"), std::string::npos) << run.err;
 }
 
+std::string mpi_rank_env(const std::string& extra) {
+  std::string env = extra;
+  if (const char* asan = std::getenv("ASAN_OPTIONS"); asan && *asan)
+    env += " ASAN_OPTIONS=" + shell_quoted(std::string(asan) + ":detect_leaks=0:use_sigaltstack=0");
+  return env;
+}
+
 }  // namespace rtcl::test

@@ -33,6 +33,17 @@ CliRun run_cli(const TempDir& dir, const std::vector<std::string>& args, const s
 CliRun run_cli_launched(const TempDir& dir, const std::string& launcher, const std::vector<std::string>& args,
                         const std::string& env = "");
 
+// The environment of MPI ranks started by a test: `extra`, and under
+// AddressSanitizer (scripts/test.sh --sanitize) leak checking off for them
+// (Open MPI 4.1 leaks from components it unloads at MPI_Finalize, so
+// LeakSanitizer's reports carry no library name to suppress them by: a
+// two-rank MPI_Bcast program built with -fsanitize=address aborts at exit)
+// and no alternate signal stacks (with them, a rank's exiting Open MPI
+// thread fails in AddressSanitizer's own unmapping of its signal stack,
+// "failed to deallocate ... unable to unmap", before any test code runs).
+// Memory errors are still caught.
+std::string mpi_rank_env(const std::string& extra = "");
+
 std::size_t count_of(const std::string& text, const std::string& fragment);
 
 // A failed run: exit `status` (1: bad input, 2: usage), exactly one
