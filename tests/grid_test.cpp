@@ -281,6 +281,44 @@ TEST(GridBuild, FlatScenesGetCellsOfPositiveSize) {
   EXPECT_GT(plane(grid.header, 2, 1), 1.0f);
 }
 
+// Slivers from a shared centre vertex to a unit circle in z = 0: each one
+// crosses the grid from the middle to the rim.
+Geometry fan(int n) {
+  Geometry g;
+  g.source = "fan";
+  g.vertices.push_back({0.0f, 0.0f, 0.0f});
+  for (int i = 0; i < n; ++i) {
+    double a = 2.0 * M_PI * i / n;
+    g.vertices.push_back({static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0.0f});
+  }
+  for (int i = 0; i < n; ++i)
+    g.triangles.push_back({0u, static_cast<std::uint32_t>(1 + i), static_cast<std::uint32_t>(1 + (i + 1) % n)});
+  return g;
+}
+
+TEST(GridBuild, AnAutomaticResolutionKeepsTheReferenceBudget) {
+  const int n = 5000;
+  Geometry g = fan(n);
+  GridConfig unbounded;
+  unbounded.max_references_per_triangle = std::numeric_limits<double>::infinity();
+  Grid dense = build_grid(g, unbounded);
+  double dense_refs = static_cast<double>(dense.refs.size()) / n;
+  ASSERT_GT(dense_refs, GridConfig{}.max_references_per_triangle) << "the fan no longer exceeds the budget";
+  Grid budgeted = build_grid(g, {});
+  double refs = static_cast<double>(budgeted.refs.size()) / n;
+  // The budget is checked on a sample of 1024 of the triangles: the whole
+  // list may exceed it by the sample's error (the fan's slivers all have
+  // the same length, so a small one).
+  EXPECT_LE(refs, 1.1 * GridConfig{}.max_references_per_triangle);
+  EXPECT_LT(std::size_t(budgeted.header.res[0]) * budgeted.header.res[1],
+            std::size_t(dense.header.res[0]) * dense.header.res[1]);
+  // An explicit resolution is kept as given.
+  GridConfig explicit_res = unbounded;
+  explicit_res.max_references_per_triangle = 1.0;
+  explicit_res.resolution = {dense.header.res[0] + 0u, dense.header.res[1] + 0u, 1u};
+  EXPECT_EQ(build_grid(g, explicit_res).refs.size(), dense.refs.size());
+}
+
 TEST(GridBuild, BadConfigAndDeviceLimitsAreErrorsNamingTheOption) {
   Geometry g = random_soup(100, 3);
   GridConfig bad;

@@ -135,6 +135,26 @@ void emit(const Frame& f, const glm::dvec3& lower, const glm::dvec3& upper, rtcl
     }
 }
 
+// Mean cell references per triangle of frame f over an evenly spaced
+// sample of at most `samples` of the first `triangle_count` stored
+// primitives (the exact overlap pass on the sample).
+double sampled_references_per_triangle(const Frame& f, const Geometry& geometry, const std::vector<std::uint32_t>& ids,
+                                       std::size_t triangle_count, std::size_t samples) {
+  std::size_t step = std::max<std::size_t>(1, triangle_count / samples), taken = 0;
+  std::vector<CellRef> out;
+  for (std::size_t k = 0; k < triangle_count; k += step, ++taken) {
+    const glm::uvec3& t = geometry.triangles[ids[k]];
+    glm::dvec3 a(geometry.vertices[t.x]), b(geometry.vertices[t.y]), c(geometry.vertices[t.z]);
+    const glm::dvec3 tri[3] = {a, b, c};
+    emit(f, glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c)), 0, false,
+         [&](const glm::dvec3& lo, const glm::dvec3& hi) {
+           return triangle_box_overlap(a, b, c, 0.5 * (lo + hi), 0.5 * (hi - lo));
+         },
+         out, tri);
+  }
+  return taken ? static_cast<double>(out.size()) / static_cast<double>(taken) : 0.0;
+}
+
 [[noreturn]] void too_large(const Geometry& g, const std::string& option, const std::string& what, std::uint64_t bytes,
                             std::size_t limit) {
   throw Error("grid over " + g.source + ": " + option + ": " + what + " need " + std::to_string(bytes) +
@@ -142,7 +162,10 @@ void emit(const Frame& f, const glm::dvec3& lower, const glm::dvec3& upper, rtcl
               " bytes, CL_DEVICE_MAX_MEM_ALLOC_SIZE); use a smaller lambda or res");
 }
 
-Frame make_frame(const Geometry& geometry, const GridConfig& config, std::size_t primitives, std::string* option) {
+// `lambda`: the density used when config.resolution is automatic (the
+// configured one, or less when the reference budget shrinks it).
+Frame make_frame(const Geometry& geometry, const GridConfig& config, double lambda, std::size_t primitives,
+                 std::string* option) {
   if (!(config.lambda > 0.0) || !std::isfinite(config.lambda))
     throw Error("grid: lambda must be > 0 (got " + std::to_string(config.lambda) + ")");
   bool explicit_res = config.resolution != GridResolution{0, 0, 0};
@@ -161,7 +184,7 @@ Frame make_frame(const Geometry& geometry, const GridConfig& config, std::size_t
   double pad = std::max(16.0 * FLT_EPSILON * magnitude, static_cast<double>(FLT_MIN));
   Frame f;
   f.widen = 64.0 * FLT_EPSILON * magnitude + static_cast<double>(FLT_MIN);
-  GridResolution res = explicit_res ? config.resolution : grid_resolution(upper - lower, primitives, config.lambda);
+  GridResolution res = explicit_res ? config.resolution : grid_resolution(upper - lower, primitives, lambda);
   std::uint64_t cells = std::uint64_t(res[0]) * res[1] * res[2];
   if (cells > kMaxCells)
     throw Error("grid over " + geometry.source + ": " + *option + ": " + resolution_text(res) + " = " +
@@ -230,8 +253,20 @@ GridResolution grid_resolution(const glm::dvec3& extent, std::size_t primitives,
 Grid build_grid(const Geometry& geometry, const GridConfig& config) {
   std::vector<std::uint32_t> ids = stored_primitives(geometry);
   std::string option;
-  Frame f = make_frame(geometry, config, ids.size(), &option);
   std::size_t triangle_count = ids.size() - geometry.spheres.size();
+  double lambda = config.lambda;
+  Frame f = make_frame(geometry, config, lambda, ids.size(), &option);
+  // The reference budget (GridConfig::max_references_per_triangle): an
+  // automatic resolution is coarsened, 4x fewer cells per round, until a
+  // sample of the triangles stays within it.
+  bool automatic = config.resolution == GridResolution{0, 0, 0};
+  for (int round = 0; automatic && round < 16 &&
+                      sampled_references_per_triangle(f, geometry, ids, triangle_count, 1024) >
+                          config.max_references_per_triangle;
+       ++round) {
+    lambda *= 0.25;
+    f = make_frame(geometry, config, lambda, ids.size(), &option);
+  }
   // The largest buffer is the reference lanes: 9 floats per reference.
   std::size_t max_refs = config.max_alloc_bytes ? config.max_alloc_bytes / (9 * sizeof(float)) : kMaxCells;
   max_refs = max_refs > kLanePadding ? max_refs - kLanePadding : 0;
