@@ -281,24 +281,9 @@ TEST(GridBuild, FlatScenesGetCellsOfPositiveSize) {
   EXPECT_GT(plane(grid.header, 2, 1), 1.0f);
 }
 
-// Slivers from a shared centre vertex to a unit circle in z = 0: each one
-// crosses the grid from the middle to the rim.
-Geometry fan(int n) {
-  Geometry g;
-  g.source = "fan";
-  g.vertices.push_back({0.0f, 0.0f, 0.0f});
-  for (int i = 0; i < n; ++i) {
-    double a = 2.0 * M_PI * i / n;
-    g.vertices.push_back({static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0.0f});
-  }
-  for (int i = 0; i < n; ++i)
-    g.triangles.push_back({0u, static_cast<std::uint32_t>(1 + i), static_cast<std::uint32_t>(1 + (i + 1) % n)});
-  return g;
-}
-
 TEST(GridBuild, AnAutomaticResolutionKeepsTheReferenceBudget) {
   const int n = 5000;
-  Geometry g = fan(n);
+  Geometry g = triangle_fan(n);
   GridConfig unbounded;
   unbounded.max_references_per_triangle = std::numeric_limits<double>::infinity();
   Grid dense = build_grid(g, unbounded);

@@ -232,16 +232,7 @@ TEST(Precision, DegenerateGeometry) {
 }
 
 TEST(Precision, HundredThousandTrianglesSharingOneVertex) {
-  Geometry g;
-  g.source = "fan of 100k triangles";
-  const int n = 100000;
-  g.vertices.push_back({0.0f, 0.0f, 0.0f});
-  for (int i = 0; i < n; ++i) {
-    double a = 2.0 * M_PI * i / n;
-    g.vertices.push_back({static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0.0f});
-  }
-  for (int i = 0; i < n; ++i)
-    g.triangles.push_back({0u, static_cast<std::uint32_t>(1 + i), static_cast<std::uint32_t>(1 + (i + 1) % n)});
+  Geometry g = triangle_fan(100000);
   std::vector<Ray> rays;
   std::mt19937 rng(78);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);

@@ -1,5 +1,6 @@
 #include "support/fixtures.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <algorithm>
@@ -47,6 +48,19 @@ std::vector<Precision> test_precisions() {
 }
 
 std::string scene_path(const std::string& relative) { return std::string(RTCL_SCENE_DIR) + "/" + relative; }
+
+Geometry triangle_fan(int count) {
+  Geometry g;
+  g.source = "fan of " + std::to_string(count) + " triangles";
+  g.vertices.push_back({0.0f, 0.0f, 0.0f});
+  for (int i = 0; i < count; ++i) {
+    double a = 2.0 * M_PI * i / count;
+    g.vertices.push_back({static_cast<float>(std::cos(a)), static_cast<float>(std::sin(a)), 0.0f});
+  }
+  for (int i = 0; i < count; ++i)
+    g.triangles.push_back({0u, static_cast<std::uint32_t>(1 + i), static_cast<std::uint32_t>(1 + (i + 1) % count)});
+  return g;
+}
 
 Geometry random_soup(std::size_t count, std::uint32_t seed, float size, float scale, glm::vec3 offset) {
   std::mt19937 rng(seed);

@@ -31,6 +31,10 @@ std::string scene_path(const std::string& relative);
 Geometry random_soup(std::size_t count, std::uint32_t seed, float size = 0.05f, float scale = 1.0f,
                      glm::vec3 offset = glm::vec3(0.0f));
 
+// `count` slivers from a shared vertex at the origin to a unit circle in
+// z = 0 (vertex 1 + i at angle 2 pi i / count).
+Geometry triangle_fan(int count);
+
 // Rays from random points on a sphere around the geometry towards random
 // points inside its bounds.
 std::vector<Ray> random_rays(const Geometry& geometry, std::size_t count, std::uint32_t seed);
