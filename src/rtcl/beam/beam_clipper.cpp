@@ -64,7 +64,11 @@ std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vec
     kernel.setArg(a++, static_cast<cl_uint>(capacity));
     kernel.setArg(a++, status_buf);
     cl::Event done;
-    check_cl(device.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(tb.tiles.size()), cl::NullRange,
+    // A small work-group: each work-item holds four regions of pieces
+    // (about 17 KB) in private memory, which PoCL replicates per work-item
+    // of a group on one thread's stack.
+    const std::size_t group = 4, global = (tb.tiles.size() + group - 1) / group * group;
+    check_cl(device.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(group),
                                                  nullptr, &done),
              "clEnqueueNDRangeKernel(clip_beams)");
     check_cl(device.queue().enqueueReadBuffer(status_buf, CL_TRUE, 0, sizeof(status), status.data(), nullptr, nullptr),
