@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "rtcl/beam/beam_layouts.hpp"
 #include "rtcl/bounds/bounds_layouts.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/render/render_layouts.hpp"

@@ -8,6 +8,7 @@
 #include "shared/render_layouts.h"
 #include "shared/sampling.h"
 #include "shared/bounds_layouts.h"
+#include "shared/beam_layouts.h"
 
 /* Byte offsets inside a private record: layout does not depend on the
  * address space, and OpenCL C 1.2 has no offsetof; the difference of two

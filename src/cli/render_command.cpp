@@ -12,6 +12,7 @@
 #include "distributed.hpp"
 #include "render_options.hpp"
 #include "rtcl/accel/accel.hpp"
+#include "rtcl/beam/beam_renderer.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/render/camera.hpp"
@@ -59,7 +60,37 @@ std::string join(const std::vector<std::string>& items) {
 
 double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? rays / (ms * 1e3) : 0.0; }
 
+// --method beam: the scene refused before the device is opened when it has
+// spheres or area lights.
+void run_beam(const RenderOptions& o) {
+  Scene scene = load_render_scene(o);
+  beam::check_beam_scene(scene);
+  check_image_path(o.output);
+  RenderPlan plan = plan_render(o, scene);
+  Device device = Device::open(o.device);
+  beam::BeamSettings bs;
+  bs.width = plan.settings.width;
+  bs.height = plan.settings.height;
+  bs.order = o.beam_order == "key" ? beam::DepthOrder::key : beam::DepthOrder::exact;
+  bs.accel = plan.accel;
+  beam::BeamStats st;
+  Image image = beam::render_beam(device, scene, bs, &st);
+  write_image(o.output, image);
+  std::printf("rtcl render: %s (%ux%u, beam tracing, %s depth order, exact pixel coverage, primary beams only: no "
+              "reflection or refraction beams, point-light shadows by shadow rays through %s, %s): %zu polygons, "
+              "%zu tile beams of 8x8 px, %zu candidates, %zu fragments, %zu pixel pieces, %zu shadow rays in %.3f s "
+              "(clipping kernel %.1f ms)\n",
+              o.output.c_str(), bs.width, bs.height, o.beam_order.c_str(), bs.accel.c_str(),
+              device.info().name.c_str(), st.polygons, st.tiles, st.candidates, st.fragments, st.pixel_pieces,
+              st.shadow_rays, st.render_ms * 1e-3, st.clip_ms);
+}
+
 void run(const RenderOptions& o) {
+  if (o.method == "beam") {
+    if (launcher_world_size()) throw Error("rtcl render --method beam: not available under mpirun (use --method ray)");
+    if (!o.accel.empty()) parse_accel_spec(o.accel);
+    return run_beam(o);
+  }
   if (launcher_world_size()) {
     refuse_ranks_without_mpi("rtcl render");
     if (mpi_supported()) return render_distributed(o);
@@ -206,6 +237,16 @@ void add_render_command(CLI::App& app) {
                   "rank reads the file itself, e.g. from a shared file system)")
       ->capture_default_str()
       ->check(CLI::IsMember({"root", "each"}));
+  cmd->add_option("--method", o->method,
+                  "ray: Whitted ray tracing; beam: beam tracing of the primary visibility (polygons and point lights "
+                  "only; exact pixel coverage, --spp and the samplers do not apply; no reflection or refraction beams)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"ray", "beam"}));
+  cmd->add_option("--beam-order", o->beam_order,
+                  "With --method beam: exact (a fragment gives up where a later polygon is nearer) | key (the walk "
+                  "in nearest-point order alone; wrong for interpenetrating polygons)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"exact", "key"}));
   cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
   cmd->add_flag("-v,--verbose", o->verbose, "Also print the device time of each stage and the queue sizes");
   cmd->callback([o] { run(*o); });

@@ -1,0 +1,42 @@
+// Beam clipping of tile beams on the host in double precision: the reference
+// the device kernel (kernels/render/beam_clip.cl) is tested against, the same
+// walk in the same order. Per tile beam (lecture, 反射光束跟踪过程（2）): walk
+// the candidates front to back; fragment = beam ∩ polygon; record it;
+// beam −= fragment; stop when the beam is empty or the list is exhausted.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "rtcl/beam/polygon2d.hpp"
+#include "rtcl/beam/screen_space.hpp"
+#include "rtcl/beam/tile_beams.hpp"
+
+namespace rtcl::beam {
+
+enum class DepthOrder {
+  // The lecture's walk alone: the first candidate in key order takes all of
+  // its projection the beam still holds. Wrong where a later candidate is in
+  // front of an earlier one over part of it (interpenetrating or cyclically
+  // overlapping polygons, and polygons whose nearest points mislead the
+  // key, e.g. a box standing on a floor).
+  key,
+  // The walk, plus: a fragment gives up the part where a later candidate's
+  // plane is nearer (1/s of two planes differs by an affine function of
+  // screen position, so "Q in front of P" is a half-plane): the visible
+  // region exactly, for any arrangement of planar polygons.
+  exact,
+};
+
+struct HostFragment {
+  std::uint32_t tile = 0, polygon = 0;  // indexes into TileBeams::tiles and the polygon list
+  Convex piece;                         // pixels
+};
+
+// Fragments in the kernel's output order (per tile: walking order, then
+// beam piece order, then fragment piece order). Pieces below
+// beam_min_area_fraction of the tile's area are dropped.
+std::vector<HostFragment> clip_beams_host(const std::vector<ScreenPolygon>& polygons, const TileBeams& tiles,
+                                          DepthOrder order);
+
+}  // namespace rtcl::beam

@@ -1,0 +1,37 @@
+// Beam clipping on the OpenCL device (kernels/render/beam_clip.cl): all tile
+// beams of the screen in one launch, one work-item per tile beam.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "rtcl/beam/beam_clip_host.hpp"
+#include "rtcl/beam/beam_layouts.hpp"
+#include "rtcl/beam/screen_space.hpp"
+#include "rtcl/beam/tile_beams.hpp"
+#include "rtcl/cl/device.hpp"
+
+namespace rtcl::beam {
+
+// The float kernel drops pieces below this fraction of the tile's area:
+// float rounding of tile-local coordinates (<= the tile's side, 2^-24
+// relative) makes areas uncertain by about 1e-6 of the tile's; far below any
+// visible coverage.
+inline constexpr float device_min_area_fraction = 1e-6f;
+
+struct DeviceClipStats {
+  double clip_ms = 0.0;             // device time of the kernel (0 without profiling)
+  std::size_t fragments = 0;        // convex fragment pieces written
+  std::size_t launches = 0;         // 2 when the fragment buffer had to grow
+};
+
+// Fragments as the device wrote them, sorted by (tile, seq): the host
+// reference's order. Throws Error naming the tile and the limit when a beam
+// needs more than RTCL_BEAM_MAX_PIECES pieces or a piece more than
+// RTCL_BEAM_PIECE_VERTS vertices, and when the fragments do not fit in the
+// device's memory (after one retry with a buffer of the size counted).
+std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vector<ScreenPolygon>& polygons,
+                                            const TileBeams& tiles, DepthOrder order,
+                                            DeviceClipStats* stats = nullptr);
+
+}  // namespace rtcl::beam
