@@ -1,6 +1,7 @@
 /* Camera rays of the wavefront renderer: one per pixel of a batch, in
  * screen-tile order (rtcl_tile_order_pixel), so that consecutive work-items
- * and packets of 8 trace coherent rays.
+ * and packets of 8 trace coherent rays; or one per pixel of a list (the
+ * selective and wavelet-guided renderers, src/rtcl/render/selective.hpp).
  *
  * Specialised by -D: RTCL_HAS_LENS (a thin-lens camera, aperture > 0). */
 #include "shared/layouts.h"
@@ -9,38 +10,29 @@
 
 inline float3 cam3(const float* a) { return (float3)(a[0], a[1], a[2]); }
 
-/* Rays first .. first+count-1 of the tile order of the region x0 .. x0+rw-1,
- * y0 .. y0+rh-1 of the image (the whole image: 0, 0, width, height), for
- * sample `sample` of `spp`: the sub-pixel position is the sampler's point in
- * dimension RTCL_DIM_PIXEL warped by the filter (shared/sampling.h); with a
- * lens, the origin is the sampler's point in RTCL_DIM_LENS on the aperture
- * disc (concentric map) and the ray passes through the pinhole ray's point
- * at the focus distance. Samples are keyed by the pixel's index in the whole
- * image, so a pixel's rays do not depend on the region. Directions are unit
- * length; tmin = 0, tmax = inf. Paths start at depth 0 with weight 1; their
- * pixel is the index inside the region, row-major. */
-kernel void generate_camera_rays(global Ray* rays, global PathState* paths, global const DeviceCamera* camera,
-                                 uint first, uint count, uint sample, uint spp, uint x0, uint y0, uint rw,
-                                 uint rh) {
-  uint i = get_global_id(0);
-  if (i >= count) return;
-  DeviceCamera c = *camera;
-  uint at = rtcl_tile_order_pixel(first + i, rw, rh);
-  uint x = x0 + at % rw, y = y0 + at / rw;
-  uint pixel = y * c.width + x;
+/* The camera ray of sample `sample` of `spp` of pixel (x, y) of the image:
+ * the sub-pixel position is the sampler's point in dimension RTCL_DIM_PIXEL
+ * warped by the filter (shared/sampling.h); with a lens, the origin is the
+ * sampler's point in RTCL_DIM_LENS on the aperture disc (concentric map) and
+ * the ray passes through the pinhole ray's point at the focus distance.
+ * Samples are keyed by the pixel's index in the whole image, so a pixel's
+ * rays do not depend on which other pixels are traced. Unit direction;
+ * tmin = 0, tmax = inf. */
+inline Ray camera_ray(const DeviceCamera* c, uint x, uint y, uint sample, uint spp) {
+  uint pixel = y * c->width + x;
   float su, sv, dx, dy;
-  rtcl_sample_2d(c.sampler, c.seed, pixel, RTCL_DIM_PIXEL, sample, spp, &su, &sv);
-  rtcl_filter_offset(c.filter, su, sv, &dx, &dy);
+  rtcl_sample_2d(c->sampler, c->seed, pixel, RTCL_DIM_PIXEL, sample, spp, &su, &sv);
+  rtcl_filter_offset(c->filter, su, sv, &dx, &dy);
   float fx = (float)x + 0.5f + dx;
   float fy = (float)y + 0.5f + dy;
-  float3 o = cam3(c.origin);
-  float3 d = cam3(c.corner) + fx * cam3(c.du) + fy * cam3(c.dv);
+  float3 o = cam3(c->origin);
+  float3 d = cam3(c->corner) + fx * cam3(c->du) + fy * cam3(c->dv);
 #ifdef RTCL_HAS_LENS
   float lu, lv, a, b;
-  rtcl_sample_2d(c.sampler, c.seed, pixel, RTCL_DIM_LENS, sample, spp, &lu, &lv);
+  rtcl_sample_2d(c->sampler, c->seed, pixel, RTCL_DIM_LENS, sample, spp, &lu, &lv);
   rtcl_concentric_disc(lu, lv, &a, &b);
-  float3 lens = a * cam3(c.lens_u) + b * cam3(c.lens_v);
-  d = c.focus_distance * d - lens; /* (origin + focus * d) - (origin + lens) */
+  float3 lens = a * cam3(c->lens_u) + b * cam3(c->lens_v);
+  d = c->focus_distance * d - lens; /* (origin + focus * d) - (origin + lens) */
   o += lens;
 #endif
   d = normalize(d);
@@ -53,10 +45,42 @@ kernel void generate_camera_rays(global Ray* rays, global PathState* paths, glob
   r.dz = d.z;
   r.tmin = 0.0f;
   r.tmax = INFINITY;
-  rays[i] = r;
+  return r;
+}
+
+inline PathState camera_path(uint pixel) {
   PathState p;
-  p.pixel = at;
+  p.pixel = pixel;
   p.depth = 0;
   p.wr = p.wg = p.wb = 1.0f;
-  paths[i] = p;
+  return p;
+}
+
+/* Rays first .. first+count-1 of the tile order of the region x0 .. x0+rw-1,
+ * y0 .. y0+rh-1 of the image (the whole image: 0, 0, width, height), for
+ * sample `sample` of `spp` (camera_ray). Paths start at depth 0 with weight
+ * 1; their pixel is the index inside the region, row-major. */
+kernel void generate_camera_rays(global Ray* rays, global PathState* paths, global const DeviceCamera* camera,
+                                 uint first, uint count, uint sample, uint spp, uint x0, uint y0, uint rw,
+                                 uint rh) {
+  uint i = get_global_id(0);
+  if (i >= count) return;
+  DeviceCamera c = *camera;
+  uint at = rtcl_tile_order_pixel(first + i, rw, rh);
+  rays[i] = camera_ray(&c, x0 + at % rw, y0 + at / rw, sample, spp);
+  paths[i] = camera_path(at);
+}
+
+/* Rays of the listed image pixels pixels[first .. first+count-1] (y * width
+ * + x, each listed once) for sample `sample` of `spp` (camera_ray), in list
+ * order; their paths carry the image pixel index, so the framebuffer is the
+ * whole image's. */
+kernel void generate_camera_rays_at(global Ray* rays, global PathState* paths, global const DeviceCamera* camera,
+                                    global const uint* pixels, uint first, uint count, uint sample, uint spp) {
+  uint i = get_global_id(0);
+  if (i >= count) return;
+  DeviceCamera c = *camera;
+  uint pixel = pixels[first + i];
+  rays[i] = camera_ray(&c, pixel % c.width, pixel / c.width, sample, spp);
+  paths[i] = camera_path(pixel);
 }

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -19,6 +20,8 @@
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/render/sampling_options.hpp"
+#include "rtcl/render/selective.hpp"
+#include "rtcl/render/wavelet.hpp"
 #include "rtcl/scene/default_scene.hpp"
 #include "rtcl/scene/scene_file.hpp"
 
@@ -58,6 +61,20 @@ std::string join(const std::vector<std::string>& items) {
   return out;
 }
 
+// A validator of real-valued options: "<value>: must be <what>".
+template <class Accept>
+CLI::Validator real_in(const std::string& what, Accept accept) {
+  return CLI::Validator(
+      [what, accept](std::string& text) {
+        try {
+          if (!accept(std::stod(text))) return text + ": must be " + what;
+        } catch (const std::exception&) {  // not a number: the option's own conversion reports it
+        }
+        return std::string();
+      },
+      what);
+}
+
 double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? rays / (ms * 1e3) : 0.0; }
 
 // --method beam: the scene refused before the device is opened when it has
@@ -85,9 +102,33 @@ void run_beam(const RenderOptions& o) {
               st.shadow_rays, st.render_ms * 1e-3, st.clip_ms);
 }
 
+// --method selective | wavelet: the image, and its summary line.
+Image render_sparse(const RenderOptions& o, const RenderPlan& plan, Renderer& renderer) {
+  SelectiveStats stats;
+  Image image;
+  if (o.method == "selective") {
+    SelectiveSettings s;
+    s.block = o.selective_block;
+    s.threshold = o.selective_threshold;
+    s.depth_threshold = o.selective_depth;
+    image = render_selective(renderer, plan.settings, s, &stats);
+  } else {
+    WaveletSettings s;
+    s.block = o.selective_block;
+    s.budget = o.wavelet_budget;
+    image = render_wavelet(renderer, plan.settings, s, &stats);
+  }
+  const double pixels = double(plan.settings.width) * plan.settings.height;
+  std::printf("rtcl render: %s: traced %llu of %.0f pixels (%.1f%%) in %u batches, %llu rays, %.3f s\n",
+              o.method.c_str(), (unsigned long long)stats.traced_pixels, pixels, 100.0 * stats.traced_pixels / pixels,
+              stats.launches, (unsigned long long)stats.rays.total(), stats.render_ms * 1e-3);
+  return image;
+}
+
 void run(const RenderOptions& o) {
+  if (launcher_world_size() && o.method != "ray")
+    throw Error("--method " + o.method + ": not under mpirun (only --method ray renders with ranks)");
   if (o.method == "beam") {
-    if (launcher_world_size()) throw Error("rtcl render --method beam: not available under mpirun (use --method ray)");
     if (!o.accel.empty()) parse_accel_spec(o.accel);
     return run_beam(o);
   }
@@ -102,6 +143,10 @@ void run(const RenderOptions& o) {
   Device device = Device::open(o.device);
   require_precision(device.info(), plan.config.precision);
   Renderer renderer(device, scene, plan.accel, plan.config);
+  if (o.method != "ray") {
+    write_image(o.output, render_sparse(o, plan, renderer));
+    return;
+  }
   ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
   Image image = renderer.render(plan.settings, [&](double f) { bar.update(f); });
   bar.finish();
@@ -212,6 +257,33 @@ void add_render_command(CLI::App& app) {
                   "Drop secondary rays whose path weight is below this (speed/accuracy; 0 keeps all)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--method", o->method,
+                  "ray: trace every pixel; selective: trace block corners, subdivide blocks whose corners differ, "
+                  "interpolate the rest; wavelet: a coarse pass, then whole blocks where its Haar coefficients are "
+                  "large, under --wavelet-budget (speed/accuracy); beam: beam tracing of the primary visibility "
+                  "(polygons and point lights only; exact pixel coverage, --spp and the samplers do not apply; no "
+                  "reflection or refraction beams)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"ray", "selective", "wavelet", "beam"}));
+  cmd->add_option("--selective-block", o->selective_block,
+                  "selective, wavelet: side of the first blocks in pixels (1 traces every pixel) (speed/accuracy)")
+      ->capture_default_str()
+      ->check(CLI::Range(1u, 256u));
+  cmd->add_option("--selective-threshold", o->selective_threshold,
+                  "selective: a block is interpolated only when its corners' display values (clamped to [0, 1]) "
+                  "span less than this per channel, they hit the same material, and their depths agree (0 traces "
+                  "every pixel) (speed/accuracy)")
+      ->capture_default_str()
+      ->check(real_in("a finite number >= 0", [](double v) { return v >= 0.0 && std::isfinite(v); }));
+  cmd->add_option("--selective-depth", o->selective_depth,
+                  "selective: ... and their first-hit distances span at most this fraction of the nearest")
+      ->capture_default_str()
+      ->check(real_in("a finite number >= 0", [](double v) { return v >= 0.0 && std::isfinite(v); }));
+  cmd->add_option("--wavelet-budget", o->wavelet_budget,
+                  "wavelet: pixels traced in all, coarse pass included, as a fraction of the image's, in (0, 1] "
+                  "(speed/accuracy)")
+      ->capture_default_str()
+      ->check(real_in("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; }));
   cmd->add_option("--batch", o->batch, "Camera rays per wavefront (device memory vs parallelism)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 26));
@@ -237,11 +309,6 @@ void add_render_command(CLI::App& app) {
                   "rank reads the file itself, e.g. from a shared file system)")
       ->capture_default_str()
       ->check(CLI::IsMember({"root", "each"}));
-  cmd->add_option("--method", o->method,
-                  "ray: Whitted ray tracing; beam: beam tracing of the primary visibility (polygons and point lights "
-                  "only; exact pixel coverage, --spp and the samplers do not apply; no reflection or refraction beams)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"ray", "beam"}));
   cmd->add_option("--beam-order", o->beam_order,
                   "With --method beam: exact (a fragment gives up where a later polygon is nearer) | key (the walk "
                   "in nearest-point order alone; wrong for interpenetrating polygons)")

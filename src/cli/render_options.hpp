@@ -24,11 +24,17 @@ struct RenderOptions {
   std::uint32_t batch = 1u << 17;
   std::string sampler = "stratified", filter = "box";
   std::uint32_t seed = 0, light_samples = 1;
-  // ray: Whitted ray tracing (src/rtcl/render); beam: beam tracing of the
-  // primary visibility (src/rtcl/beam/beam_renderer.hpp), with the depth
-  // order of its walk (exact | key).
+  // ray: Whitted ray tracing, every pixel traced (src/rtcl/render);
+  // selective: block corners traced, blocks subdivided where they differ,
+  // the rest interpolated; wavelet: a coarse pass, then whole blocks where
+  // its Haar coefficients are large, under a budget (rtcl/render/
+  // selective.hpp, wavelet.hpp); beam: beam tracing of the primary
+  // visibility (src/rtcl/beam/beam_renderer.hpp), with the depth order of
+  // its walk (exact | key).
   std::string method = "ray";
   std::string beam_order = "exact";
+  std::uint32_t selective_block = 8;
+  float selective_threshold = 0.05f, selective_depth = 0.1f, wavelet_budget = 0.25f;
   bool quiet = false;
   bool verbose = false;
   // Under mpirun only: tile side in pixels (a multiple of 8), the order

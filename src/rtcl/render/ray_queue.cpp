@@ -81,6 +81,7 @@ RayQueue::RayQueue(const Device& device) : device_(device) {
     cl::Program generate = device_.program("render/generate.cl", {});
     cl::Program compact = device_.program("render/compact.cl", {});
     generate_ = cl::Kernel(generate, "generate_camera_rays");
+    generate_at_ = cl::Kernel(generate, "generate_camera_rays_at");
     count_ = cl::Kernel(compact, "count_flags");
     scan_ = cl::Kernel(compact, "scan_counts");
     scatter_ = cl::Kernel(compact, "compact_spawned_rays");
@@ -88,7 +89,11 @@ RayQueue::RayQueue(const Device& device) : device_(device) {
 }
 
 void RayQueue::specialise_generation(const std::vector<std::string>& defines) {
-  with_cl_errors([&] { generate_ = cl::Kernel(device_.program("render/generate.cl", defines), "generate_camera_rays"); });
+  with_cl_errors([&] {
+    cl::Program generate = device_.program("render/generate.cl", defines);
+    generate_ = cl::Kernel(generate, "generate_camera_rays");
+    generate_at_ = cl::Kernel(generate, "generate_camera_rays_at");
+  });
 }
 
 cl::Event RayQueue::generate_camera_rays(const cl::Buffer& camera, std::uint32_t first, std::uint32_t count,
@@ -111,6 +116,25 @@ cl::Event RayQueue::generate_camera_rays(const cl::Buffer& camera, std::uint32_t
     generate_.setArg(9, static_cast<cl_uint>(rw));
     generate_.setArg(10, static_cast<cl_uint>(rh));
     return launch(device_, generate_, std::max<std::uint32_t>(count, 1), wait);
+  });
+}
+
+cl::Event RayQueue::generate_camera_rays_at(const cl::Buffer& camera, const cl::Buffer& pixels, std::uint32_t first,
+                                            std::uint32_t count, std::uint32_t sample, std::uint32_t spp,
+                                            const std::vector<cl::Event>& wait) {
+  rays_.reserve(device_, count);
+  paths_.reserve(device_, count);
+  size_ = count;
+  return with_cl_errors([&] {
+    generate_at_.setArg(0, rays_.buffer());
+    generate_at_.setArg(1, paths_.buffer());
+    generate_at_.setArg(2, camera);
+    generate_at_.setArg(3, pixels);
+    generate_at_.setArg(4, static_cast<cl_uint>(first));
+    generate_at_.setArg(5, static_cast<cl_uint>(count));
+    generate_at_.setArg(6, static_cast<cl_uint>(sample));
+    generate_at_.setArg(7, static_cast<cl_uint>(spp));
+    return launch(device_, generate_at_, std::max<std::uint32_t>(count, 1), wait);
   });
 }
 

@@ -78,6 +78,14 @@ class RayQueue {
                                  std::uint32_t sample, std::uint32_t spp, std::uint32_t x0, std::uint32_t y0,
                                  std::uint32_t rw, std::uint32_t rh, const std::vector<cl::Event>& wait);
 
+  // Fills the queue with camera rays of the image pixels pixels[first ..
+  // first + count - 1] (a device buffer of y * width + x, each pixel listed
+  // once) for sample `sample` of `spp`, in list order; paths carry the image
+  // pixel index.
+  cl::Event generate_camera_rays_at(const cl::Buffer& camera, const cl::Buffer& pixels, std::uint32_t first,
+                                    std::uint32_t count, std::uint32_t sample, std::uint32_t spp,
+                                    const std::vector<cl::Event>& wait);
+
   // Replaces the contents with these rays and paths (same length).
   void assign(const std::vector<Ray>& rays, const std::vector<PathState>& paths);
   // The rays and paths queued now (blocking read, after `wait`).
@@ -94,7 +102,7 @@ class RayQueue {
   Device device_;
   GrowingBuffer rays_{"ray queue", sizeof(Ray)}, paths_{"path states", sizeof(PathState)}, chunk_counts_{"compaction counts", RTCL_CHUNK_COUNT_BYTES};
   std::size_t size_ = 0;
-  cl::Kernel generate_, count_, scan_, scatter_;
+  cl::Kernel generate_, generate_at_, count_, scan_, scatter_;
 };
 
 // The dense queue of shadow rays and their any-hit answers.

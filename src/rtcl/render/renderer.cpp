@@ -179,28 +179,11 @@ Image Renderer::render(const RenderSettings& settings, const ImageRegion& region
   for (std::uint32_t sample = 0; sample < settings.spp; ++sample)
     for (std::uint32_t first = 0; first < pixels; first += settings.batch_pixels) {
       std::uint32_t count = std::min(settings.batch_pixels, pixels - first);
-      double done = double(sample) * pixels + first;
       s.sample = sample;
       generate(first, count, sample);
-      for (std::uint32_t generation = 0; s.queue.size() > 0; ++generation) {
-        trace(generation == 0);
-        shade();
-        compact();
-        trace_shadows();
-        accumulate();
-        std::swap(s.queue, s.next);
-        s.stats.generations++;
-        if (progress)
-          progress((done + count * std::min(1.0, (generation + 1.0) / (settings.max_depth + 1.0))) / total_work);
-      }
-      collect_times();
+      trace_batch(count, double(sample) * pixels + first, total_work, progress, nullptr);
     }
-
-  static_assert(sizeof(cl_float4) == RTCL_RADIANCE_BYTES);
-  std::vector<cl_float4> sums(pixels);
-  with_cl_errors([&] {
-    s.device.queue().enqueueReadBuffer(s.framebuffer, CL_TRUE, 0, sums.size() * RTCL_RADIANCE_BYTES, sums.data(), wait_list(s.last));
-  });
+  std::vector<cl_float4> sums = read_framebuffer(pixels);
   Image image;
   image.width = s.region.width;
   image.height = s.region.height;
@@ -208,13 +191,102 @@ Image Renderer::render(const RenderSettings& settings, const ImageRegion& region
   const float inv = 1.0f / static_cast<float>(settings.spp);
   for (std::size_t p = 0; p < pixels; ++p)
     for (int c = 0; c < 3; ++c) image.rgb[p * 3 + c] = sums[p].s[c] * inv;
+  finish_stats(start);
+  if (progress) progress(1.0);
+  return image;
+}
+
+PixelSamples Renderer::render_pixels(const RenderSettings& settings, const std::vector<std::uint32_t>& pixels) {
+  auto start = std::chrono::steady_clock::now();
+  prepare(settings, ImageRegion{});
+  State& s = *s_;
+  const std::size_t image_pixels = std::size_t(settings.width) * settings.height;
+  std::vector<bool> listed(image_pixels, false);
+  for (std::uint32_t p : pixels) {
+    if (p >= image_pixels)
+      throw Error("render_pixels: pixel " + std::to_string(p) + " is outside the " + std::to_string(settings.width) +
+                  "x" + std::to_string(settings.height) + " image");
+    if (listed[p]) throw Error("render_pixels: pixel " + std::to_string(p) + " is listed twice");
+    listed[p] = true;
+  }
+  PixelSamples out;
+  const auto n = static_cast<std::uint32_t>(pixels.size());
+  out.rgb.resize(std::size_t(n) * 3);
+  out.depth.resize(n);
+  out.object.resize(n);
+  if (n == 0) {
+    finish_stats(start);
+    return out;
+  }
+  cl::Buffer list = s.device.upload(pixels.data(), pixels.size() * sizeof(std::uint32_t), "pixel list");
+  std::vector<Hit> hits;
+  for (std::uint32_t sample = 0; sample < settings.spp; ++sample)
+    for (std::uint32_t first = 0; first < n; first += settings.batch_pixels) {
+      std::uint32_t count = std::min(settings.batch_pixels, n - first);
+      s.sample = sample;
+      cl::Event e = s.queue.generate_camera_rays_at(s.camera, list, first, count, sample, settings.spp, s.last);
+      s.generates.push_back(e);
+      s.last = {e};
+      s.stats.rays.camera += count;
+      trace_batch(count, 0.0, 1.0, {}, sample == 0 ? &hits : nullptr);
+      for (std::uint32_t i = 0; sample == 0 && i < count; ++i) {
+        const Hit& h = hits[i];
+        const bool hit = h.prim >= 0;
+        out.depth[first + i] = hit ? h.t : INFINITY;
+        out.object[first + i] = hit ? static_cast<std::int32_t>(s.flat.material.at(std::size_t(h.prim))) : -1;
+      }
+    }
+  std::vector<cl_float4> sums = read_framebuffer(image_pixels);
+  const float inv = 1.0f / static_cast<float>(settings.spp);
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) out.rgb[std::size_t(i) * 3 + c] = sums[pixels[i]].s[c] * inv;
+  finish_stats(start);
+  return out;
+}
+
+void Renderer::trace_batch(std::uint32_t count, double done, double total_work, const RenderProgress& progress,
+                           std::vector<Hit>* first_hits) {
+  State& s = *s_;
+  const RenderSettings& settings = s.settings;
+  for (std::uint32_t generation = 0; s.queue.size() > 0; ++generation) {
+    trace(generation == 0);
+    if (generation == 0 && first_hits) {
+      first_hits->resize(s.queue.size());
+      with_cl_errors([&] {
+        s.device.queue().enqueueReadBuffer(s.hits.buffer(), CL_TRUE, 0, first_hits->size() * sizeof(Hit),
+                                           first_hits->data(), wait_list(s.last));
+      });
+    }
+    shade();
+    compact();
+    trace_shadows();
+    accumulate();
+    std::swap(s.queue, s.next);
+    s.stats.generations++;
+    if (progress)
+      progress((done + count * std::min(1.0, (generation + 1.0) / (settings.max_depth + 1.0))) / total_work);
+  }
+  collect_times();
+}
+
+std::vector<cl_float4> Renderer::read_framebuffer(std::size_t pixels) {
+  State& s = *s_;
+  static_assert(sizeof(cl_float4) == RTCL_RADIANCE_BYTES);
+  std::vector<cl_float4> sums(pixels);
+  with_cl_errors([&] {
+    s.device.queue().enqueueReadBuffer(s.framebuffer, CL_TRUE, 0, sums.size() * RTCL_RADIANCE_BYTES, sums.data(),
+                                       wait_list(s.last));
+  });
+  return sums;
+}
+
+void Renderer::finish_stats(std::chrono::steady_clock::time_point start) {
+  State& s = *s_;
   s.stats.queue_bytes = s.queue.bytes() + s.next.bytes() + s.shadows.bytes() + s.hits.bytes() +
                         s.radiance.bytes() + s.spawn.rays.bytes() + s.spawn.paths.bytes() + s.spawn.flags.bytes() +
                         s.shadow_slots.rays.bytes() + s.shadow_slots.weights.bytes() +
                         s.shadow_slots.flags.bytes() + s.shadow_slots.index.bytes();
   s.stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  if (progress) progress(1.0);
-  return image;
 }
 
 std::vector<std::vector<TreeRay>> Renderer::ray_tree(const Ray& ray, const RenderSettings& settings) {

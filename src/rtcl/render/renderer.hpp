@@ -12,6 +12,7 @@
 // lights, rough materials or an aperture; the light loop unrolled).
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -85,6 +86,14 @@ struct TreeRay {
   PathState path;  // pixel, depth, weight
 };
 
+// The samples of a list of pixels (Renderer::render_pixels), parallel to
+// the list.
+struct PixelSamples {
+  std::vector<float> rgb;            // 3 per pixel, linear: the mean of its spp samples
+  std::vector<float> depth;          // distance along sample 0's camera ray to its first hit; +inf: a miss
+  std::vector<std::int32_t> object;  // the material index of that hit; -1: a miss
+};
+
 // Called with the fraction of the work done, in [0, 1], after each
 // generation of each batch.
 using RenderProgress = std::function<void(double fraction)>;
@@ -114,6 +123,16 @@ class Renderer {
   // when it is empty or leaves the image.
   Image render(const RenderSettings& settings, const ImageRegion& region, const RenderProgress& progress = {});
 
+  // Only the listed pixels of the image (y * width + x, each at most once,
+  // in any order): camera rays for all of them in the same launches
+  // (batches of settings.batch_pixels, one per pixel sample), traced,
+  // shaded and accumulated like render(settings)'s, so each pixel's colour
+  // is that image's pixel bit for bit. Its first hit (depth, material) is
+  // read back from sample 0's camera rays. For selective tracing
+  // (selective.hpp). Throws Error naming a pixel outside the image or
+  // listed twice.
+  PixelSamples render_pixels(const RenderSettings& settings, const std::vector<std::uint32_t>& pixels);
+
   // The ray tree of one ray, for inspection and tests: generation 0 is
   // `ray` (weight 1, depth 0), generation g + 1 the reflected and refracted
   // rays that generation g spawns on the device (settings.max_depth and
@@ -130,6 +149,12 @@ class Renderer {
   std::unique_ptr<State> s_;
 
   void prepare(const RenderSettings& settings, const ImageRegion& region);
+  // Traces the queued camera rays of one batch through every generation;
+  // with `first_hits`, reads back their closest hits first.
+  void trace_batch(std::uint32_t count, double done, double total_work, const RenderProgress& progress,
+                   std::vector<Hit>* first_hits);
+  std::vector<cl_float4> read_framebuffer(std::size_t pixels);
+  void finish_stats(std::chrono::steady_clock::time_point start);
   void generate(std::uint32_t first, std::uint32_t count, std::uint32_t sample);
   void trace(bool camera_rays);
   void shade();
