@@ -15,7 +15,10 @@
  * RTCL_HAS_REFLECTION (some material has kr > 0 or kt > 0),
  * RTCL_HAS_REFRACTION (some material has kt > 0), RTCL_HAS_AREA_LIGHTS (a
  * quad, disc or sphere light), RTCL_HAS_GLOSSY (a reflecting material with
- * roughness > 0). */
+ * roughness > 0), RTCL_HAS_MOTION (moving primitives: triangles and spheres
+ * hold shutter open, triangles_close and spheres_close shutter close, and a
+ * path's primitives lie at open + tau * (close - open), tau its sample's
+ * time, as in accel/bvh_motion.cl). */
 #include "shared/layouts.h"
 #include "shared/render_layouts.h"
 #include "shared/sampling.h"
@@ -73,24 +76,49 @@ typedef struct SurfacePoint {
   uint material;
 } SurfacePoint;
 
+#ifdef RTCL_HAS_MOTION
+/* A keyframe-interpolated point: the arithmetic of accel/bvh_motion.cl. */
+inline float3 motion_lerp3(global const float* a, global const float* b, float tau) {
+  return (float3)(a[0] + tau * (b[0] - a[0]), a[1] + tau * (b[1] - a[1]), a[2] + tau * (b[2] - a[2]));
+}
+#define MOTION_SURFACE_PARAMS , float tau, global const ShadeTriangle *triangles_close, global const ShadeSphere *spheres_close
+#define MOTION_SURFACE_ARGS , tau, triangles_close, spheres_close
+#else
+#define MOTION_SURFACE_PARAMS
+#define MOTION_SURFACE_ARGS
+#endif
+
 inline SurfacePoint surface_point(const Ray r, const Hit h, global const ShadeTriangle* triangles,
-                                  uint triangle_count, global const ShadeSphere* spheres) {
+                                  uint triangle_count, global const ShadeSphere* spheres MOTION_SURFACE_PARAMS) {
   SurfacePoint s;
 #ifdef RTCL_HAS_SPHERES
   if ((uint)h.prim >= triangle_count) {
     global const ShadeSphere* sp = spheres + ((uint)h.prim - triangle_count);
+#ifdef RTCL_HAS_MOTION
+    global const ShadeSphere* sz = spheres_close + ((uint)h.prim - triangle_count);
+    float3 c = motion_lerp3(sp->center, sz->center, tau);
+    float radius = sp->radius + tau * (sz->radius - sp->radius);
+#else
     float3 c = load3g(sp->center);
+    float radius = sp->radius;
+#endif
     float3 p = (float3)(r.ox, r.oy, r.oz) + h.t * (float3)(r.dx, r.dy, r.dz);
     s.ng = normalize(p - c);
-    s.p = c + sp->radius * s.ng;
-    s.offset = RTCL_SPAWN_OFFSET(s.p, sp->radius);
+    s.p = c + radius * s.ng;
+    s.offset = RTCL_SPAWN_OFFSET(s.p, radius);
     s.material = sp->material;
     return s;
   }
 #endif
   global const ShadeTriangle* t = triangles + h.prim;
+#ifdef RTCL_HAS_MOTION
+  global const ShadeTriangle* tz = triangles_close + h.prim;
+  float3 v0 = motion_lerp3(t->v[0], tz->v[0], tau);
+  float3 e1 = motion_lerp3(t->v[1], tz->v[1], tau) - v0, e2 = motion_lerp3(t->v[2], tz->v[2], tau) - v0;
+#else
   float3 v0 = load3g(t->v[0]);
   float3 e1 = load3g(t->v[1]) - v0, e2 = load3g(t->v[2]) - v0;
+#endif
   float extent = fmax(max3(fabs(e1)), max3(fabs(e2)));
   s.p = v0 + h.u * e1 + h.v * e2;
   float inv = 1.0f / extent; /* scaled before the cross product: no under/overflow at any scene scale */
@@ -180,7 +208,11 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
                        global const ShadeParams* params, global float4* radiance, global Ray* shadow_rays,
                        global float4* shadow_weight, global uint* shadow_flags, global Ray* spawn_rays,
                        global PathState* spawn_paths, global uint* spawn_flags, uint sample, uint x0, uint y0,
-                       uint rw, uint width) {
+                       uint rw, uint width
+#ifdef RTCL_HAS_MOTION
+                       , global const ShadeTriangle* triangles_close, global const ShadeSphere* spheres_close
+#endif
+                       ) {
   uint i = get_global_id(0);
   if (i >= count) return;
   ShadeParams P = *params;
@@ -198,7 +230,10 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
   }
   Ray r = rays[i];
   float3 d = normalize((float3)(r.dx, r.dy, r.dz));
-  SurfacePoint s = surface_point(r, h, triangles, P.triangle_count, spheres);
+#ifdef RTCL_HAS_MOTION
+  const float tau = rtcl_sample_time(P.sampler, P.seed, image_pixel, sample, P.spp);
+#endif
+  SurfacePoint s = surface_point(r, h, triangles, P.triangle_count, spheres MOTION_SURFACE_ARGS);
   global const DeviceMaterial* m = materials + s.material;
   float cos_i = -dot(d, s.ng);
   int front = cos_i > 0.0f; /* the ray arrives on the side the normal points to */

@@ -249,6 +249,29 @@ inline void rtcl_phong_lobe(float exponent, float u, float v, float* cos_a, floa
  * lobe's n = 0, small r a sharp lobe. */
 inline float rtcl_roughness_exponent(float roughness) { return 2.0f / (roughness * roughness) - 2.0f; }
 
+/* The time dimension (motion blur): one 1D decision per path, shared by all
+ * of its rays (a sample is one instant), numbered far above the per-bounce
+ * dimensions so that adding it changes no other decision. */
+#define RTCL_DIM_TIME 0xfffffff0u
+
+/* Time of sample `index` (< count) of `pixel`, a fraction of the shutter
+ * interval in [0, 1): stratified: one jittered point in each of `count`
+ * strata, the strata shuffled per pixel; random and sobol: the first
+ * coordinate of their 2D point (Sobol's is a scrambled van der Corput
+ * sequence, stratified for count = 2^m). */
+inline float rtcl_sample_time(rtcl_u32 sampler, rtcl_u32 seed, rtcl_u32 pixel, rtcl_u32 index, rtcl_u32 count) {
+  if (sampler == RTCL_SAMPLER_STRATIFIED) {
+    rtcl_u32 key = rtcl_sample_key(seed, pixel, RTCL_DIM_TIME, 4u);
+    rtcl_u32 stratum = count <= 1u ? 0u : rtcl_permute(index, count, key);
+    float jitter = rtcl_unit_float(rtcl_hash(key ^ rtcl_hash(index + 0x632be5abu)));
+    float t = ((float)stratum + jitter) * (1.0f / (float)count);
+    return t < 1.0f ? t : 0.99999994f; /* rounding up to 1 in the last stratum */
+  }
+  float u, v;
+  rtcl_sample_2d(sampler, seed, pixel, RTCL_DIM_TIME, index, count, &u, &v);
+  return u;
+}
+
 #ifndef __OPENCL_VERSION__
 } /* namespace rtcl */
 #endif

@@ -8,6 +8,7 @@
 
 #include "rtcl/render/camera.hpp"
 #include "rtcl/render/render_layouts.hpp"
+#include "rtcl/scene/motion.hpp"
 #include "rtcl/scene/orthonormal_basis.hpp"
 
 namespace rtcl::test {
@@ -34,23 +35,37 @@ struct RefHit {
 
 class Tracer {
  public:
+  // A moving scene's primitives are its keyframes at the camera's shutter
+  // open and close (flattened to float, as the renderer's input), each
+  // sample's at open + tau * (close - open) in double.
   Tracer(const Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {
-    FlatScene flat = flatten(scene);
+    const bool moves = scene_moves(scene);
+    FlatScene flat = flatten(moves ? scene_at(scene, scene.camera.shutter_open) : scene);
+    FlatScene end = moves ? flatten(scene_at(scene, scene.camera.shutter_close)) : flat;
     material_ = flat.material;
-    lights_ = expand_emissive_lights(scene, flat);
+    lights_ = expand_emissive_lights(moves ? scene_at(scene, scene.camera.shutter_open) : scene, flat);
     const Geometry& g = flat.geometry;
+    const Geometry& ge = end.geometry;
     for (std::size_t t = 0; t < g.triangles.size(); ++t) {
       Tri tri;
-      for (int k = 0; k < 3; ++k) tri.v[k] = dvec3(g.vertices[g.triangles[t][k]]);
+      for (int k = 0; k < 3; ++k) {
+        tri.v[k] = dvec3(g.vertices[g.triangles[t][k]]);
+        tri.motion[k] = dvec3(ge.vertices[ge.triangles[t][k]]) - tri.v[k];
+      }
       tri.skip = zero_area(g, t);  // no structure stores zero-area triangles
       triangles_.push_back(tri);
     }
-    for (const Sphere& s : g.spheres) spheres_.push_back({dvec3(s.center), double(s.radius)});
+    for (std::size_t i = 0; i < g.spheres.size(); ++i)
+      spheres_.push_back({dvec3(g.spheres[i].center), double(g.spheres[i].radius),
+                          dvec3(ge.spheres[i].center) - dvec3(g.spheres[i].center),
+                          double(ge.spheres[i].radius) - double(g.spheres[i].radius)});
   }
 
-  // The sample being traced: the sampler's points come from (pixel, sample).
+  // The sample being traced: the sampler's points come from (pixel, sample);
+  // tau is its time (a fraction of the shutter interval).
   struct SampleId {
     std::uint32_t pixel = 0, sample = 0;
+    double tau = 0.0;
   };
 
   void sample_2d(const SampleId& id, std::uint32_t dimension, std::uint32_t index, std::uint32_t count, double& u,
@@ -89,7 +104,7 @@ class Tracer {
   // decision the ray tree makes.
   dvec3 trace(const dvec3& o, const dvec3& d, const dvec3& w, std::uint32_t depth, const SampleId& id,
               std::uint64_t& signature) const {
-    RefHit h = closest(o, d, std::numeric_limits<double>::infinity(), false);
+    RefHit h = closest(o, d, std::numeric_limits<double>::infinity(), false, id.tau);
     mix(signature, static_cast<std::uint64_t>(h.prim + 1));
     if (h.prim < 0) return w * dvec3(scene_.background);
 
@@ -97,13 +112,13 @@ class Tracer {
     dvec3 p, ng;
     double extent;
     if (static_cast<std::size_t>(h.prim) < triangles_.size()) {
-      const Tri& t = triangles_[h.prim];
+      const Tri t = triangles_[h.prim].at(id.tau);
       dvec3 e1 = t.v[1] - t.v[0], e2 = t.v[2] - t.v[0];
       p = t.v[0] + h.u * e1 + h.v * e2;
       ng = glm::normalize(glm::cross(e1, e2));
       extent = std::max(max_abs3(e1), max_abs3(e2));
     } else {
-      const Ball& s = spheres_[h.prim - triangles_.size()];
+      const Ball s = spheres_[h.prim - triangles_.size()].at(id.tau);
       ng = glm::normalize(o + h.t * d - s.center);
       p = s.center + s.radius * ng;
       extent = s.radius;
@@ -138,7 +153,7 @@ class Tracer {
         }
         dvec3 c = w * dvec3(light.color) * double(light.intensity) * f / double(points);
         if (!(max3(c) > 0.0)) continue;
-        bool occluded = closest(above, q - above, 1.0 - shadow_shorten, true).prim >= 0;
+        bool occluded = closest(above, q - above, 1.0 - shadow_shorten, true, id.tau).prim >= 0;
         mix(signature, occluded ? 0x51u : 0x52u);
         if (!occluded) radiance += c;
       }
@@ -186,23 +201,33 @@ class Tracer {
  private:
   struct Tri {
     dvec3 v[3];
+    dvec3 motion[3];  // close - open per vertex (zero when static)
     bool skip = false;
+    Tri at(double tau) const {
+      Tri t = *this;
+      for (int k = 0; k < 3; ++k) t.v[k] = v[k] + tau * motion[k];
+      return t;
+    }
   };
   struct Ball {
     dvec3 center;
     double radius;
+    dvec3 center_motion{0.0};
+    double radius_motion = 0.0;
+    Ball at(double tau) const { return {center + tau * center_motion, radius + tau * radius_motion}; }
   };
 
   static void mix(std::uint64_t& s, std::uint64_t value) {
     s ^= value + 0x9e3779b97f4a7c15ull + (s << 6) + (s >> 2);
   }
 
-  // Nearest hit with 0 <= t <= tmax (t in units of |d|); any: the first found.
-  RefHit closest(const dvec3& o, const dvec3& d, double tmax, bool any) const {
+  // Nearest hit with 0 <= t <= tmax (t in units of |d|) at time tau; any:
+  // the first found.
+  RefHit closest(const dvec3& o, const dvec3& d, double tmax, bool any, double tau) const {
     RefHit best;
     best.t = tmax;
     for (std::size_t i = 0; i < triangles_.size(); ++i) {
-      const Tri& tri = triangles_[i];
+      const Tri tri = triangles_[i].at(tau);
       if (tri.skip) continue;
       // Möller-Trumbore in double.
       dvec3 e1 = tri.v[1] - tri.v[0], e2 = tri.v[2] - tri.v[0];
@@ -222,7 +247,7 @@ class Tracer {
     }
     double a = glm::dot(d, d);
     for (std::size_t i = 0; i < spheres_.size(); ++i) {
-      const Ball& s = spheres_[i];
+      const Ball s = spheres_[i].at(tau);
       dvec3 f = o - s.center;
       double b = -glm::dot(f, d);
       dvec3 l = f + (b / a) * d;
@@ -291,7 +316,8 @@ ReferenceImage reference_render(const Scene& scene, const RenderSettings& settin
           double fy = y + 0.5 + double(jy) + offsets[k][1] * ambiguity_px;
           dvec3 pinhole = frame.corner + fx * frame.du + fy * frame.dv;  // unit length along the view
           dvec3 d = glm::normalize(lens_radius > 0.0 ? focus * pinhole - lens : pinhole);
-          dvec3 radiance = tracer.trace(frame.origin + lens, d, dvec3(1.0), 0, {pixel, sample}, signature[k]);
+          double tau = rtcl_sample_time(sampler, settings.seed, pixel, sample, settings.spp);
+          dvec3 radiance = tracer.trace(frame.origin + lens, d, dvec3(1.0), 0, {pixel, sample, tau}, signature[k]);
           if (k == 0) sum += radiance;
           if (signature[k] != signature[0]) out.ambiguous[pixel] = 1;
         }

@@ -64,6 +64,7 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
       slot.args_set = true;
     }
     cl::Kernel& kernel = slot.kernel;
+    set_call_args(kernel);
     kernel.setArg(0, rays);
     kernel.setArg(1, hits);
     kernel.setArg(2, static_cast<cl_uint>(ray_count));

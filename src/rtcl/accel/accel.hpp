@@ -109,6 +109,10 @@ class Accel {
         std::vector<std::string> defines, AccelStats stats, const AccelConfig& config);
   // Sets the structure's kernel arguments, starting at argument `first`.
   virtual void set_structure_args(cl::Kernel& kernel, cl_uint first) const = 0;
+  // Sets arguments that change with each trace call (after rays, hits and
+  // ray_count; a structure with such arguments starts its own after them):
+  // per-ray data such as ray times (MotionBvh). Called before every launch.
+  virtual void set_call_args(cl::Kernel&) const {}
 
  private:
   struct QueryKernel {

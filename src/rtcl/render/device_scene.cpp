@@ -90,27 +90,43 @@ std::vector<std::string> generate_defines(const Scene& scene) {
   return {};
 }
 
-DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat) {
+namespace {
+
+struct ShadeRecords {
+  std::vector<ShadeTriangle> triangles;  // at least one (a placeholder)
+  std::vector<ShadeSphere> spheres;      // at least one
+};
+
+ShadeRecords shade_records(const FlatScene& flat) {
   const Geometry& g = flat.geometry;
-  std::vector<ShadeTriangle> triangles(std::max<std::size_t>(g.triangles.size(), 1));
+  ShadeRecords r;
+  r.triangles.resize(std::max<std::size_t>(g.triangles.size(), 1));
   for (std::size_t t = 0; t < g.triangles.size(); ++t) {
-    for (int k = 0; k < 3; ++k) store(triangles[t].v[k], g.vertices[g.triangles[t][k]]);
-    triangles[t].material = flat.material[t];
+    for (int k = 0; k < 3; ++k) store(r.triangles[t].v[k], g.vertices[g.triangles[t][k]]);
+    r.triangles[t].material = flat.material[t];
   }
-  std::vector<ShadeSphere> spheres(std::max<std::size_t>(g.spheres.size(), 1));
+  r.spheres.resize(std::max<std::size_t>(g.spheres.size(), 1));
   for (std::size_t s = 0; s < g.spheres.size(); ++s) {
-    store(spheres[s].center, g.spheres[s].center);
-    spheres[s].radius = g.spheres[s].radius;
-    spheres[s].material = flat.material[g.triangles.size() + s];
+    store(r.spheres[s].center, g.spheres[s].center);
+    r.spheres[s].radius = g.spheres[s].radius;
+    r.spheres[s].material = flat.material[g.triangles.size() + s];
   }
+  return r;
+}
+
+}  // namespace
+
+DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat, const FlatScene* close) {
+  const Geometry& g = flat.geometry;
+  ShadeRecords records = shade_records(flat);
   std::vector<DeviceMaterial> materials;
   for (const Material& m : scene.materials) materials.push_back(pack(m));
   if (materials.empty()) materials.emplace_back();
   std::vector<DeviceLight> lights(std::max<std::size_t>(scene.lights.size(), 1));
   for (std::size_t l = 0; l < scene.lights.size(); ++l) lights[l] = pack(scene.lights[l]);
   DeviceScene d;
-  d.triangles = device.upload(triangles.data(), triangles.size() * sizeof(ShadeTriangle), "shading triangles");
-  d.spheres = device.upload(spheres.data(), spheres.size() * sizeof(ShadeSphere), "shading spheres");
+  d.triangles = device.upload(records.triangles.data(), records.triangles.size() * sizeof(ShadeTriangle), "shading triangles");
+  d.spheres = device.upload(records.spheres.data(), records.spheres.size() * sizeof(ShadeSphere), "shading spheres");
   d.materials = device.upload(materials.data(), materials.size() * sizeof(DeviceMaterial), "materials");
   d.lights = device.upload(lights.data(), lights.size() * sizeof(DeviceLight), "lights");
   d.triangle_count = static_cast<std::uint32_t>(g.triangles.size());
@@ -118,6 +134,12 @@ DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatSce
   d.light_count = static_cast<std::uint32_t>(scene.lights.size());
   d.defines = shade_defines(scene, flat);
   d.generate_defines = generate_defines(scene);
+  if (close) {
+    ShadeRecords end = shade_records(*close);
+    d.triangles_close = device.upload(end.triangles.data(), end.triangles.size() * sizeof(ShadeTriangle), "shading triangles at shutter close");
+    d.spheres_close = device.upload(end.spheres.data(), end.spheres.size() * sizeof(ShadeSphere), "shading spheres at shutter close");
+    d.defines.push_back("RTCL_HAS_MOTION");
+  }
   return d;
 }
 

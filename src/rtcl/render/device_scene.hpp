@@ -17,12 +17,16 @@ struct DeviceScene {
   cl::Buffer spheres;    // ShadeSphere per sphere (id - triangle_count); a placeholder when none
   cl::Buffer materials;  // DeviceMaterial
   cl::Buffer lights;     // DeviceLight; a placeholder when none
+  // A moving scene's primitives at shutter close (triangles, spheres as
+  // above; those above are at open); empty for a static scene.
+  cl::Buffer triangles_close, spheres_close;
   std::uint32_t triangle_count = 0, sphere_count = 0, light_count = 0;
   // RTCL_LIGHT_COUNT=n always; RTCL_HAS_SPHERES with spheres;
   // RTCL_HAS_REFLECTION when some primitive's material has kr > 0 or kt > 0;
   // RTCL_HAS_REFRACTION when some primitive's material has kt > 0;
   // RTCL_HAS_AREA_LIGHTS with a quad, disc or sphere light; RTCL_HAS_GLOSSY
-  // when some primitive's reflecting material has roughness > 0.
+  // when some primitive's reflecting material has roughness > 0;
+  // RTCL_HAS_MOTION for a moving scene (upload_scene with `close`).
   std::vector<std::string> defines;
   // Of the camera-ray kernel: RTCL_HAS_LENS when the camera has an aperture.
   std::vector<std::string> generate_defines;
@@ -30,6 +34,9 @@ struct DeviceScene {
 
 std::vector<std::string> shade_defines(const Scene& scene, const FlatScene& flat);
 std::vector<std::string> generate_defines(const Scene& scene);
-DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat);
+// `flat`: the primitives (at shutter open when the scene moves); `close`:
+// the same primitives at shutter close, for a moving scene only.
+DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat,
+                         const FlatScene* close = nullptr);
 
 }  // namespace rtcl

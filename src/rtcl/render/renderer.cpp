@@ -10,6 +10,7 @@
 #include "rtcl/render/launch.hpp"
 #include "rtcl/render/ray_queue.hpp"
 #include "rtcl/render/render_layouts.hpp"
+#include "rtcl/scene/motion.hpp"
 
 namespace rtcl {
 
@@ -70,9 +71,13 @@ struct Renderer::State {
   Device device;
   Scene scene;
   FlatScene flat;
-  std::unique_ptr<Accel> accel;
+  std::unique_ptr<Accel> accel;       // static scenes
+  std::unique_ptr<MotionBvh> motion;  // moving scenes
   DeviceScene shading;
   cl::Kernel shade, accumulate;
+  // Moving scenes: the ray-time kernels and the queue's and shadow queue's times.
+  cl::Kernel queue_times, shadow_times;
+  GrowingBuffer times{"ray times", sizeof(float)}, shadow_time{"shadow ray times", sizeof(float)};
 
   // Per render.
   RenderSettings settings;
@@ -95,12 +100,38 @@ struct Renderer::State {
   State(const Device& d, const Scene& s) : device(d), scene(s), queue(d), next(d), shadows(d) {}
 };
 
-Renderer::Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config)
+Renderer::Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config,
+                   MotionBounds motion_bounds)
     : s_(std::make_unique<State>(device, scene)) {
-  s_->flat = flatten(scene);
-  s_->scene.lights = expand_emissive_lights(scene, s_->flat);
-  s_->accel = make_accel(device, accel_name, s_->flat.geometry, config);
-  s_->shading = upload_scene(device, s_->scene, s_->flat);
+  if (!scene_moves(scene)) {
+    s_->flat = flatten(scene);
+    s_->scene.lights = expand_emissive_lights(scene, s_->flat);
+    s_->accel = make_accel(device, accel_name, s_->flat.geometry, config);
+    s_->shading = upload_scene(device, s_->scene, s_->flat);
+  } else {
+    if (parse_accel_spec(accel_name).name != "bvh")
+      throw Error("--accel " + std::string(accel_name) + ": " + scene.source +
+                  " has moving objects, which only the motion BVH traces (use --accel bvh)");
+    const double open = scene.camera.shutter_open, close = scene.camera.shutter_close;
+    check_motion(scene, open, close);
+    Scene at_open = scene_at(scene, open), at_close = scene_at(scene, close);
+    s_->flat = flatten(at_open);
+    FlatScene end = flatten(at_close);
+    s_->scene.lights = expand_emissive_lights(at_open, s_->flat);
+    std::vector<Light> end_lights = expand_emissive_lights(at_close, end);
+    for (std::size_t l = 0; l < end_lights.size(); ++l)
+      if (end_lights[l].position != s_->scene.lights[l].position || end_lights[l].edge1 != s_->scene.lights[l].edge1 ||
+          end_lights[l].edge2 != s_->scene.lights[l].edge2)
+        throw Error(scene.source + ": an emitting triangle of a moving mesh lights the scene (lights of type "
+                    "emissive must not move)");
+    s_->motion = std::make_unique<MotionBvh>(device, s_->flat.geometry, end.geometry, motion_bounds, config);
+    s_->shading = upload_scene(device, s_->scene, s_->flat, &end);
+    with_cl_errors([&] {
+      cl::Program program = device.program("render/ray_times.cl", {});
+      s_->queue_times = cl::Kernel(program, "queue_ray_times");
+      s_->shadow_times = cl::Kernel(program, "shadow_ray_times");
+    });
+  }
   s_->queue.specialise_generation(s_->shading.generate_defines);
   s_->next.specialise_generation(s_->shading.generate_defines);
   if (config.precision == Precision::fast) s_->shading.defines.push_back("RTCL_FIXED_SPAWN_OFFSET");
@@ -115,7 +146,7 @@ Renderer::Renderer(const Device& device, const Scene& scene, std::string_view ac
 Renderer::~Renderer() = default;
 
 const RenderStats& Renderer::stats() const { return s_->stats; }
-const Accel& Renderer::accel() const { return *s_->accel; }
+const Accel& Renderer::accel() const { return s_->accel ? *s_->accel : *s_->motion; }
 const std::vector<std::string>& Renderer::defines() const { return s_->shading.defines; }
 
 // Per render: camera, shading constants, a cleared framebuffer.
@@ -249,6 +280,7 @@ void Renderer::trace_batch(std::uint32_t count, double done, double total_work, 
   State& s = *s_;
   const RenderSettings& settings = s.settings;
   for (std::uint32_t generation = 0; s.queue.size() > 0; ++generation) {
+    queue_times();
     trace(generation == 0);
     if (generation == 0 && first_hits) {
       first_hits->resize(s.queue.size());
@@ -259,6 +291,7 @@ void Renderer::trace_batch(std::uint32_t count, double done, double total_work, 
     }
     shade();
     compact();
+    shadow_times();
     trace_shadows();
     accumulate();
     std::swap(s.queue, s.next);
@@ -301,9 +334,11 @@ std::vector<std::vector<TreeRay>> Renderer::ray_tree(const Ray& ray, const Rende
     s.queue.read(rays, paths, s.last);
     tree.emplace_back();
     for (std::size_t i = 0; i < rays.size(); ++i) tree.back().push_back(TreeRay{rays[i], paths[i]});
+    queue_times();
     trace(tree.size() == 1);
     shade();
     compact();
+    shadow_times();
     trace_shadows();
     accumulate();
     std::swap(s.queue, s.next);
@@ -331,8 +366,9 @@ void Renderer::trace(bool camera_rays) {
   std::size_t n = s.queue.size();
   s.stats.peak_queue = std::max(s.stats.peak_queue, n);
   const cl::Buffer& hits = s.hits.reserve(s.device, n);
-  cl::Event e = s.accel->trace(Query::closest, s.queue.rays(), hits, n, s.last,
-                               camera_rays ? Coherence::coherent : Coherence::incoherent);
+  Coherence coherence = camera_rays ? Coherence::coherent : Coherence::incoherent;
+  cl::Event e = s.motion ? s.motion->trace(Query::closest, s.queue.rays(), RayTimes{s.times.buffer()}, hits, n, s.last, coherence)
+                         : s.accel->trace(Query::closest, s.queue.rays(), hits, n, s.last, coherence);
   (camera_rays ? s.camera_traces : s.secondary_traces).push_back(e);
   s.last = {e};
 }
@@ -369,6 +405,10 @@ void Renderer::shade() {
     k.setArg(a++, static_cast<cl_uint>(s.region.y0));
     k.setArg(a++, static_cast<cl_uint>(s.region.width));
     k.setArg(a++, static_cast<cl_uint>(s.settings.width));
+    if (s.motion) {
+      k.setArg(a++, s.shading.triangles_close);
+      k.setArg(a++, s.shading.spheres_close);
+    }
     cl::Event e = launch(s.device, k, n, s.last);
     s.shades.push_back(e);
     s.last = {e};
@@ -403,10 +443,56 @@ void Renderer::compact() {
 void Renderer::trace_shadows() {
   State& s = *s_;
   if (s.shadows.size() == 0) return;
-  cl::Event e = s.accel->trace(Query::any, s.shadows.rays(), s.shadows.hits(), s.shadows.size(), s.last,
-                               Coherence::coherent);
+  cl::Event e = s.motion ? s.motion->trace(Query::any, s.shadows.rays(), RayTimes{s.shadow_time.buffer()},
+                                           s.shadows.hits(), s.shadows.size(), s.last, Coherence::coherent)
+                         : s.accel->trace(Query::any, s.shadows.rays(), s.shadows.hits(), s.shadows.size(), s.last,
+                                          Coherence::coherent);
   s.shadow_traces.push_back(e);
   s.last = {e};
+}
+
+// queue_times (moving scenes): each queued ray's time, from its path's
+// pixel and the sample being traced.
+void Renderer::queue_times() {
+  State& s = *s_;
+  if (!s.motion) return;
+  std::size_t n = s.queue.size();
+  s.times.reserve(s.device, std::max<std::size_t>(n, 1));
+  with_cl_errors([&] {
+    cl::Kernel& k = s.queue_times;
+    cl_uint a = 0;
+    k.setArg(a++, s.queue.paths());
+    k.setArg(a++, static_cast<cl_uint>(n));
+    k.setArg(a++, static_cast<cl_uint>(s.sample));
+    k.setArg(a++, static_cast<cl_uint>(s.settings.spp));
+    k.setArg(a++, static_cast<cl_uint>(s.settings.sampler));
+    k.setArg(a++, static_cast<cl_uint>(s.settings.seed));
+    k.setArg(a++, static_cast<cl_uint>(s.region.x0));
+    k.setArg(a++, static_cast<cl_uint>(s.region.y0));
+    k.setArg(a++, static_cast<cl_uint>(s.region.width));
+    k.setArg(a++, static_cast<cl_uint>(s.settings.width));
+    k.setArg(a++, s.times.buffer());
+    s.last = {launch(s.device, k, n, s.last)};
+  });
+}
+
+// shadow_times (moving scenes): each shadow ray takes the time of the ray
+// whose hit cast it.
+void Renderer::shadow_times() {
+  State& s = *s_;
+  if (!s.motion || s.shadows.size() == 0) return;
+  s.shadow_time.reserve(s.device, s.shadows.size());
+  with_cl_errors([&] {
+    cl::Kernel& k = s.shadow_times;
+    cl_uint a = 0;
+    k.setArg(a++, s.times.buffer());
+    k.setArg(a++, static_cast<cl_uint>(s.queue.size()));
+    k.setArg(a++, static_cast<cl_uint>(s.slots_per_ray));
+    k.setArg(a++, s.shadow_slots.flags.buffer());
+    k.setArg(a++, s.shadow_slots.index.buffer());
+    k.setArg(a++, s.shadow_time.buffer());
+    s.last = {launch(s.device, k, s.queue.size(), s.last)};
+  });
 }
 
 // accumulate: this generation's radiance, per pixel, into the framebuffer.

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "rtcl/accel/accel.hpp"
+#include "rtcl/accel/bvh_motion.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/render_layouts.hpp"
@@ -103,8 +104,13 @@ class Renderer {
   // Flattens and validates the scene, builds the named acceleration
   // structure over it (with `config`: its precision level also picks the
   // spawn offsets, see kernels/render/shade.cl) and the kernels specialised
-  // to it. Throws Error.
-  Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config = {});
+  // to it. A moving scene (rtcl/scene/motion.hpp) is flattened at the
+  // camera's shutter open and close and traced by the MotionBvh with
+  // `motion_bounds` (accel_name must then be "bvh"; the kernels get
+  // RTCL_HAS_MOTION and each ray its sample's time); a static scene has no
+  // time code. Throws Error.
+  Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config = {},
+           MotionBounds motion_bounds = MotionBounds::interpolated);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -141,7 +147,7 @@ class Renderer {
   std::vector<std::vector<TreeRay>> ray_tree(const Ray& ray, const RenderSettings& settings);
 
   const RenderStats& stats() const;          // of the last render
-  const Accel& accel() const;
+  const Accel& accel() const;  // the MotionBvh when the scene moves
   const std::vector<std::string>& defines() const;  // the shade kernel's -D options
 
  private:
@@ -160,6 +166,8 @@ class Renderer {
   void shade();
   void compact();
   void trace_shadows();
+  void queue_times();
+  void shadow_times();
   void accumulate();
   void collect_times();
 };

@@ -189,10 +189,15 @@ Scene transform_scene(const Scene& scene, const glm::dmat4& t) {
     l.normal = glm::vec3(glm::dmat3(t) * glm::dvec3(l.normal) / s);
     l.radius = static_cast<float>(l.radius * s);
   }
-  for (SceneMesh& m : out.meshes) m.transform = t * m.transform;
+  for (SceneMesh& m : out.meshes) {
+    m.transform = t * m.transform;
+    if (m.end_transform) m.end_transform = t * *m.end_transform;
+  }
   for (SceneSphere& sp : out.spheres) {
     sp.center = glm::dvec3(t * glm::dvec4(sp.center, 1.0));
     sp.radius *= s;
+    sp.end_center = glm::dvec3(t * glm::dvec4(sp.end_center, 1.0));
+    sp.end_radius *= s;
   }
   return out;
 }

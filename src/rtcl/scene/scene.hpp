@@ -72,6 +72,11 @@ struct Camera {
   // here: the distance to look_at).
   float aperture = 0.0f;
   float focus_distance = 0.0f;
+  // Shutter interval on the keyframe time axis of moving objects (keyframe
+  // 0 at time 0, keyframe 1 at time 1; open <= close, finite). Each ray's
+  // time is drawn uniformly from it (motion blur); it matters only where an
+  // object moves.
+  float shutter_open = 0.0f, shutter_close = 1.0f;
 };
 
 // A triangle mesh in object space with its object-to-world transform.
@@ -81,6 +86,12 @@ struct SceneMesh {
   std::vector<glm::uvec3> triangles;
   std::vector<std::uint32_t> materials;  // one per triangle, index into Scene::materials
   glm::dmat4 transform{1.0};             // object to world; a mirroring one keeps faces outward
+  // Motion: the object-to-world transform at keyframe time 1 (`transform`
+  // is keyframe 0); at time t the transform is the blend (1 - t) * transform
+  // + t * end_transform, so every vertex moves on a straight line at
+  // constant speed, beyond [0, 1] too (rtcl/scene/motion.hpp). None: static.
+  std::optional<glm::dmat4> end_transform;
+  std::string motion_key;  // where the motion was given ("scene.json: objects[2].motion"): named in errors
 };
 
 // A sphere in world space (spheres are transformed when loaded).
@@ -88,6 +99,12 @@ struct SceneSphere {
   glm::dvec3 center{0.0};
   double radius = 1.0;
   std::uint32_t material = 0;
+  // Motion: centre and radius at keyframe time 1 (center, radius: keyframe
+  // 0); both move linearly in time. Only when `moving`.
+  bool moving = false;
+  glm::dvec3 end_center{0.0};
+  double end_radius = 1.0;
+  std::string motion_key;  // as SceneMesh::motion_key
 };
 
 struct Scene {

@@ -12,7 +12,7 @@ namespace rtcl {
 namespace {
 
 constexpr std::uint32_t magic = 0x6c637472u;  // "rtcl"
-constexpr std::uint32_t version = 1;
+constexpr std::uint32_t version = 2;  // 2: roughness, motion keyframes
 
 class Writer {
  public:
@@ -104,6 +104,7 @@ std::vector<std::byte> scene_to_bytes(const Scene& scene) {
     w.pod(m.kr);
     w.pod(m.kt);
     w.pod(m.ior);
+    w.pod(m.roughness);
   }
   w.pod(std::uint64_t(scene.meshes.size()));
   for (const SceneMesh& m : scene.meshes) {
@@ -112,8 +113,20 @@ std::vector<std::byte> scene_to_bytes(const Scene& scene) {
     w.array(m.triangles);
     w.array(m.materials);
     w.pod(m.transform);
+    w.pod(std::uint8_t(m.end_transform.has_value()));
+    if (m.end_transform) w.pod(*m.end_transform);
+    w.text(m.motion_key);
   }
-  w.array(scene.spheres);
+  w.pod(std::uint64_t(scene.spheres.size()));
+  for (const SceneSphere& s : scene.spheres) {
+    w.pod(s.center);
+    w.pod(s.radius);
+    w.pod(s.material);
+    w.pod(std::uint8_t(s.moving));
+    w.pod(s.end_center);
+    w.pod(s.end_radius);
+    w.text(s.motion_key);
+  }
   w.pod(std::uint64_t(scene.notes.size()));
   for (const std::string& note : scene.notes) w.text(note);
   w.pod(std::int32_t(scene.precision ? static_cast<int>(*scene.precision) : -1));
@@ -142,6 +155,7 @@ Scene scene_from_bytes(std::span<const std::byte> bytes, const std::string& what
     m.kr = r.pod<glm::vec3>();
     m.kt = r.pod<glm::vec3>();
     m.ior = r.pod<float>();
+    m.roughness = r.pod<float>();
   }
   scene.meshes.resize(r.count());
   for (SceneMesh& m : scene.meshes) {
@@ -150,8 +164,19 @@ Scene scene_from_bytes(std::span<const std::byte> bytes, const std::string& what
     m.triangles = r.array<glm::uvec3>();
     m.materials = r.array<std::uint32_t>();
     m.transform = r.pod<glm::dmat4>();
+    if (r.pod<std::uint8_t>()) m.end_transform = r.pod<glm::dmat4>();
+    m.motion_key = r.text();
   }
-  scene.spheres = r.array<SceneSphere>();
+  scene.spheres.resize(r.count());
+  for (SceneSphere& s : scene.spheres) {
+    s.center = r.pod<glm::dvec3>();
+    s.radius = r.pod<double>();
+    s.material = r.pod<std::uint32_t>();
+    s.moving = r.pod<std::uint8_t>() != 0;
+    s.end_center = r.pod<glm::dvec3>();
+    s.end_radius = r.pod<double>();
+    s.motion_key = r.text();
+  }
   scene.notes.resize(r.count());
   for (std::string& note : scene.notes) note = r.text();
   std::int32_t precision = r.pod<std::int32_t>();

@@ -1,6 +1,7 @@
 #include "rtcl/scene/scene_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -13,6 +14,7 @@
 
 #include "rtcl/accel/options.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/scene/motion.hpp"
 
 namespace rtcl {
 
@@ -119,7 +121,7 @@ glm::dmat4 read_transform(const Reader& r, const json& v, const std::string& whe
 
 Camera read_camera(const Reader& r, const json& v) {
   const std::string where = "camera";
-  r.object(v, where, {"position", "look_at", "up", "fov", "aspect", "aperture", "focus_distance"});
+  r.object(v, where, {"position", "look_at", "up", "fov", "aspect", "aperture", "focus_distance", "shutter"});
   Camera c;
   c.position = to_float(r.vec3(r.required(v, where, "position"), "camera.position"));
   c.look_at = to_float(r.vec3(r.required(v, where, "look_at"), "camera.look_at"));
@@ -139,6 +141,15 @@ Camera read_camera(const Reader& r, const json& v) {
     double f = r.number(v["focus_distance"], "camera.focus_distance");
     if (!(f > 0.0)) r.fail("camera.focus_distance", "must be positive, got " + v["focus_distance"].dump());
     c.focus_distance = static_cast<float>(f);
+  }
+  if (v.contains("shutter")) {
+    const json& s = v["shutter"];
+    if (!s.is_array() || s.size() != 2) r.fail("camera.shutter", "expected [open, close] (keyframe times)");
+    double open = r.number(s[0], "camera.shutter[0]"), close = r.number(s[1], "camera.shutter[1]");
+    if (!std::isfinite(open) || !std::isfinite(close) || open > close)
+      r.fail("camera.shutter", "must be finite with open <= close, got " + s.dump());
+    c.shutter_open = static_cast<float>(open);
+    c.shutter_close = static_cast<float>(close);
   }
   return c;
 }
@@ -312,23 +323,35 @@ class SceneBuilder {
   }
 
   void read_sphere(const json& v, const std::string& where) {
-    r_.object(v, where, {"type", "center", "radius", "material", "transform"});
+    r_.object(v, where, {"type", "center", "radius", "material", "transform", "motion"});
     SceneSphere s;
     s.center = r_.vec3(r_.required(v, where, "center"), Reader::join(where, "center"));
     s.radius = r_.number(r_.required(v, where, "radius"), Reader::join(where, "radius"));
     if (!(s.radius > 0.0)) r_.fail(Reader::join(where, "radius"), "must be positive");
     s.material = material_named(r_.required(v, where, "material"), Reader::join(where, "material"));
+    glm::dmat4 t(1.0);
     if (v.contains("transform")) {
       std::string at = Reader::join(where, "transform");
-      glm::dmat4 t = read_transform(r_, v["transform"], at);
-      s.radius *= similarity_scale(t, r_.source() + ": " + at + " (a sphere's scale must be uniform)");
-      s.center = glm::dvec3(t * glm::dvec4(s.center, 1.0));
+      t = read_transform(r_, v["transform"], at);
+      similarity_scale(t, r_.source() + ": " + at + " (a sphere's scale must be uniform)");
+    }
+    glm::dvec3 object_center = s.center;
+    double object_radius = s.radius;
+    s.radius = object_radius * similarity_scale(t, r_.source() + ": " + where);
+    s.center = glm::dvec3(t * glm::dvec4(object_center, 1.0));
+    if (v.contains("motion")) {
+      std::string at = Reader::join(where, "motion");
+      glm::dmat4 end = read_transform(r_, v["motion"], at) * t;
+      s.moving = true;
+      s.motion_key = r_.source() + ": " + at;
+      s.end_radius = object_radius * similarity_scale(end, s.motion_key + " (a sphere's scale must stay uniform)");
+      s.end_center = glm::dvec3(end * glm::dvec4(object_center, 1.0));
     }
     scene_.spheres.push_back(s);
   }
 
   void read_mesh(const json& v, const std::string& where) {
-    r_.object(v, where, {"type", "file", "material", "materials", "transform"});
+    r_.object(v, where, {"type", "file", "material", "materials", "transform", "motion"});
     std::string file_at = Reader::join(where, "file");
     std::string file = r_.string(r_.required(v, where, "file"), file_at);
     std::filesystem::path path = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : base_dir_ / file;
@@ -369,6 +392,11 @@ class SceneBuilder {
     mesh.materials.reserve(loaded.triangle_material.size());
     for (std::uint32_t m : loaded.triangle_material) mesh.materials.push_back(map.at(m));
     if (v.contains("transform")) mesh.transform = read_transform(r_, v["transform"], Reader::join(where, "transform"));
+    if (v.contains("motion")) {
+      std::string at = Reader::join(where, "motion");
+      mesh.end_transform = read_transform(r_, v["motion"], at) * mesh.transform;
+      mesh.motion_key = r_.source() + ": " + at;
+    }
     scene_.meshes.push_back(std::move(mesh));
   }
 
@@ -410,7 +438,9 @@ Material material_from_mtl(const MeshMaterial& mm) {
 Scene parse_scene(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
   Reader reader(source);
   json root = parse_strict(text, reader);
-  return SceneBuilder(reader, base_dir).build(root);
+  Scene scene = SceneBuilder(reader, base_dir).build(root);
+  check_motion(scene, scene.camera.shutter_open, scene.camera.shutter_close);
+  return scene;
 }
 
 Scene load_scene(const std::string& path) {

@@ -1,0 +1,37 @@
+// Moving objects (motion blur; Cook, Porter & Carpenter 1984): keyframe
+// time 0 is an object's `transform` (a sphere's centre and radius), keyframe
+// time 1 its end keyframe (SceneMesh::end_transform, SceneSphere::end_*).
+// At time t a mesh's object-to-world transform is the blend
+// (1 - t) * transform + t * end_transform, so each vertex moves on a straight
+// line at constant speed, and a sphere's centre and radius move linearly.
+// Rotations are blended as matrices, not as rotations: a large rotation
+// shrinks the object in between (180 degrees flattens it: refused).
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "rtcl/scene/scene.hpp"
+
+namespace rtcl {
+
+// Whether some mesh or sphere has an end keyframe (even one equal to its
+// start: the renderer then takes the moving path).
+bool scene_moves(const Scene& scene);
+
+// The mesh's object-to-world transform at keyframe time `time`.
+glm::dmat4 transform_at(const SceneMesh& mesh, double time);
+// The sphere at keyframe time `time` (static: itself).
+SceneSphere sphere_at(const SceneSphere& sphere, double time);
+
+// The static scene of every object at keyframe time `time` (end keyframes
+// dropped); flatten() of it is the world-space geometry at that time.
+Scene scene_at(const Scene& scene, double time);
+
+// Throws Error naming the object's motion key when a moving mesh's blended
+// transform is singular (its determinant vanishes or changes sign: the mesh
+// collapses onto a plane) or a moving sphere's radius is not positive at
+// some time of [t0, t1]; and naming camera.shutter when the interval is not
+// finite or t0 > t1.
+void check_motion(const Scene& scene, double t0, double t1);
+
+}  // namespace rtcl
