@@ -24,9 +24,9 @@ struct RenderOptions {
   std::uint32_t batch = 1u << 17;
   std::string sampler = "stratified", filter = "box";
   std::uint32_t seed = 0, light_samples = 1;
-  // ray: Whitted ray tracing (src/rtcl/render); beam: beam tracing of the
-  // primary visibility (src/rtcl/beam/beam_renderer.hpp), with the depth
-  // order of its walk (exact | key).
+  // ray: Whitted ray tracing (src/rtcl/render); beam: beam tracing with
+  // reflection beams (src/rtcl/beam/beam_renderer.hpp), with the depth order
+  // of its walk (exact | key).
   std::string method = "ray";
   std::string beam_order = "exact";
   bool quiet = false;
