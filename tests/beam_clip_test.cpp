@@ -59,7 +59,7 @@ struct BeamSetup {
   Geometry geometry;
   beam::ScreenSpace screen;
   std::vector<beam::ScreenPolygon> polygons;
-  beam::TileBeams tiles;
+  beam::BeamSet tiles;
 };
 
 BeamSetup make_setup(float s, std::uint32_t w = 44, std::uint32_t h = 36) {
@@ -112,7 +112,7 @@ template <class Frag, class Contains>
 std::size_t visibility_mismatches(const BeamSetup& u, const std::vector<Frag>& frags, Contains contains,
                                   std::size_t* checked) {
   std::multimap<std::uint32_t, const Frag*> by_tile;
-  for (const Frag& f : frags) by_tile.emplace(f.tile, &f);
+  for (const Frag& f : frags) by_tile.emplace(f.beam, &f);
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   std::size_t bad = 0;
@@ -174,11 +174,11 @@ TEST(BeamClip, DeviceMatchesHostDoubleClipper) {
     // (<= 32 px) times that; 1e-3 px^2 covers the up to 32 pieces of a beam
     // with margin and is 1/64000 of a tile.
     std::map<std::pair<std::uint32_t, std::uint32_t>, double> areas;
-    for (const auto& f : host) areas[std::make_pair(f.tile, f.polygon)] += beam::signed_area(f.piece.v);
+    for (const auto& f : host) areas[std::make_pair(f.beam, f.polygon)] += beam::signed_area(f.piece.v);
     for (const auto& f : dev) {
       std::vector<dvec2> v;
       for (std::uint32_t k = 0; k < f.count; ++k) v.push_back({f.x[k], f.y[k]});
-      areas[std::make_pair(f.tile, f.polygon)] -= beam::signed_area(v);
+      areas[std::make_pair(f.beam, f.polygon)] -= beam::signed_area(v);
     }
     for (const auto& [key, diff] : areas)
       EXPECT_NEAR(diff, 0.0, 1e-3) << "tile " << key.first << " polygon " << key.second;
@@ -195,6 +195,39 @@ TEST(BeamClip, DeviceMatchesHostDoubleClipper) {
   }
 }
 
+TEST(BeamClip, SliverWithVerticesEqualInFloat) {
+  // A floor triangle cut by a mirror plane to a sliver whose two vertices
+  // differ by 1e-7 px, in the wrong order (a spike): equal in float, so the
+  // device must merge them (once, it kept the whole beam on both sides of
+  // the zero-length edge and emitted the next polygon twice); in double the
+  // reversed edge would clip the sliver away, so screen polygons are made
+  // strictly convex first (as screen_polygons does).
+  auto poly = [](std::vector<dvec2> v, double inv_depth, std::uint32_t prim) {
+    beam::ScreenPolygon p;
+    p.v = beam::make_strictly_convex(beam::Convex{std::move(v)}, 1e-9 * 200).v;
+    p.inv_depth = {0.0, 0.0, inv_depth};
+    p.prim = prim;
+    return p;
+  };
+  std::vector<beam::ScreenPolygon> polys{
+      poly({{97, 94.1953004}, {94.1953007, 94.1953004}, {75.2122121, 75.2122119}, {97, 78.9104918}}, 0.3, 0),
+      poly({{97, 78.9104918}, {75.2122121, 75.2122119}, {75.212212, 75.2122119}, {97, 75.2122119}}, 0.25, 1),
+      poly({{97, 75.2122119}, {75.212212, 75.2122119}, {75.212212, 21.0599101}, {97, 42.8476981}}, 0.2, 2)};
+  beam::BeamSet set;
+  beam::add_beam(set, beam::rectangle(80, 72, 88, 80), polys, 0, 3);
+  for (DepthOrder order : {DepthOrder::key, DepthOrder::exact}) {
+    std::vector<double> host(3, 0.0), dev(3, 0.0);
+    for (const auto& f : beam::clip_beams_host(polys, set, order)) host[f.polygon] += beam::signed_area(f.piece.v);
+    for (const auto& f : beam::clip_beams_device(test_device(), polys, set, order)) {
+      std::vector<dvec2> v;
+      for (std::uint32_t k = 0; k < f.count; ++k) v.push_back({f.x[k], f.y[k]});
+      dev[f.polygon] += beam::signed_area(v);
+    }
+    for (int p = 0; p < 3; ++p) EXPECT_NEAR(dev[p], host[p], 1e-3) << p;
+    EXPECT_NEAR(host[0] + host[1] + host[2], 64.0, 1e-9);
+  }
+}
+
 TEST(BeamClip, TooManyPiecesIsAnErrorNamingTheTile) {
   // 24 small disjoint triangles in one 8x8 tile: the beam's remainder grows
   // by two pieces per triangle, past RTCL_BEAM_MAX_PIECES.
@@ -207,12 +240,12 @@ TEST(BeamClip, TooManyPiecesIsAnErrorNamingTheTile) {
     p.prim = std::uint32_t(i);
     polys.push_back(p);
   }
-  beam::TileBeams tb = beam::tile_beams(polys, 8, 8);
+  beam::BeamSet tb = beam::tile_beams(polys, 8, 8);
   try {
     beam::clip_beams_device(test_device(), polys, tb, DepthOrder::key);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("tile beam at pixel (0, 0)"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("beam at pixel (0, 0)"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("32 convex pieces"), std::string::npos) << e.what();
   }
 }

@@ -173,6 +173,13 @@ TEST(Polygon2d, CollinearAndDegenerateInput) {
     Region strip = beam::subtract(big, beam::rectangle(0, 0, s * 0.999, s), beam::beam_min_area_fraction * s * s);
     EXPECT_NEAR(beam::area(strip), 1e-3 * s * s, 1e-12 * s * s) << s;
   }
+  // A spike of two near-copies of one vertex in the wrong order, and an
+  // exactly collinear vertex, are removed; the square is what remains.
+  beam::Convex spiky{{{0, 0}, {0.5, 0}, {1, 0}, {1, 1}, {0, 1}, {1e-13, 1}, {0, 1}, {0, 0.5}}};
+  beam::Convex clean = beam::make_strictly_convex(spiky, 1e-12);
+  EXPECT_EQ(clean.v.size(), 4u);
+  EXPECT_NEAR(beam::signed_area(clean.v), 1.0, 1e-12);
+  EXPECT_TRUE(beam::make_strictly_convex(beam::Convex{{{0, 0}, {1, 1}, {2, 2}}}, 1e-12).v.empty());
   // Ear clipping of an L shape and its errors.
   Region l = beam::triangulate({{0, 0}, {2, 0}, {2, 1}, {1, 1}, {1, 2}, {0, 2}});
   EXPECT_DOUBLE_EQ(beam::area(l), 3.0);

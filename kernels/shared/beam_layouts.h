@@ -32,26 +32,30 @@ typedef struct BeamPolygon {
   rtcl_u32 count;     /* vertices, 3 .. RTCL_BEAM_POLYGON_VERTS */
 } BeamPolygon;
 
-/* One tile beam: the prism over the screen rectangle [x0, x0 + w] x [y0,
- * y0 + h] and its candidate polygons candidates[first .. first + count), in
- * walking order (nearest key first): 24 bytes. */
-typedef struct BeamTile {
-  rtcl_u32 x0, y0, w, h;
+/* One beam: the prism over a convex screen polygon (a tile's square for the
+ * viewing beam's tiles, a mirror fragment for a reflected beam) and its
+ * candidate polygons candidates[first .. first + count), in walking order
+ * (nearest key first): 148 bytes. The kernel works in coordinates relative
+ * to (x0, y0), a point near the beam (float precision of its size). */
+typedef struct Beam {
+  float x[RTCL_BEAM_PIECE_VERTS], y[RTCL_BEAM_PIECE_VERTS]; /* counter-clockwise, pixels */
+  float x0, y0;
+  rtcl_u32 vertex_count; /* 3 .. RTCL_BEAM_PIECE_VERTS */
   rtcl_u32 first, count;
-} BeamTile;
+} Beam;
 
-/* One convex piece of a polygon's visible fragment in one tile beam: 144
- * bytes. seq: its position in the tile's output order. */
+/* One convex piece of a polygon's visible fragment in one beam: 144 bytes.
+ * seq: its position in the beam's output order. */
 typedef struct BeamFragment {
-  rtcl_u32 tile, polygon, seq, count;
+  rtcl_u32 beam, polygon, seq, count;
   float x[RTCL_BEAM_PIECE_VERTS], y[RTCL_BEAM_PIECE_VERTS];
 } BeamFragment;
 
 /* Status words of one clipping launch (rtcl_u32 each). */
 #define RTCL_BEAM_STATUS_FRAGMENTS 0      /* fragments written or wanted (may exceed the capacity) */
-#define RTCL_BEAM_STATUS_PIECE_OVERFLOW 1 /* tiles whose region needed more than RTCL_BEAM_MAX_PIECES pieces */
-#define RTCL_BEAM_STATUS_VERT_OVERFLOW 2  /* tiles whose piece needed more than RTCL_BEAM_PIECE_VERTS vertices */
-#define RTCL_BEAM_STATUS_FIRST_TILE 3     /* smallest tile index with an overflow; 0xffffffff: none */
+#define RTCL_BEAM_STATUS_PIECE_OVERFLOW 1 /* beams whose region needed more than RTCL_BEAM_MAX_PIECES pieces */
+#define RTCL_BEAM_STATUS_VERT_OVERFLOW 2  /* beams whose piece needed more than RTCL_BEAM_PIECE_VERTS vertices */
+#define RTCL_BEAM_STATUS_FIRST_TILE 3     /* smallest beam index with an overflow; 0xffffffff: none */
 #define RTCL_BEAM_STATUS_WORDS 4
 
 #ifndef __OPENCL_VERSION__

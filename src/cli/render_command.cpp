@@ -90,16 +90,18 @@ void run_beam(const RenderOptions& o) {
   bs.height = plan.settings.height;
   bs.order = o.beam_order == "key" ? beam::DepthOrder::key : beam::DepthOrder::exact;
   bs.accel = plan.accel;
+  bs.max_depth = plan.settings.max_depth;
+  bs.min_weight = plan.settings.min_weight;
   beam::BeamStats st;
   Image image = beam::render_beam(device, scene, bs, &st);
   write_image(o.output, image);
-  std::printf("rtcl render: %s (%ux%u, beam tracing, %s depth order, exact pixel coverage, primary beams only: no "
-              "reflection or refraction beams, point-light shadows by shadow rays through %s, %s): %zu polygons, "
-              "%zu tile beams of 8x8 px, %zu candidates, %zu fragments, %zu pixel pieces, %zu shadow rays in %.3f s "
-              "(clipping kernel %.1f ms)\n",
-              o.output.c_str(), bs.width, bs.height, o.beam_order.c_str(), bs.accel.c_str(),
-              device.info().name.c_str(), st.polygons, st.tiles, st.candidates, st.fragments, st.pixel_pieces,
-              st.shadow_rays, st.render_ms * 1e-3, st.clip_ms);
+  std::printf("rtcl render: %s (%ux%u, beam tracing, %s depth order, exact pixel coverage, reflection beams to "
+              "depth %u, no refraction beams, point-light shadows by shadow rays through %s, %s): %zu polygons, "
+              "%zu tile beams of 8x8 px + %zu reflected beams in %u levels, %zu candidates, %zu fragments, %zu pixel "
+              "pieces, %zu shadow rays in %.3f s (clipping kernels %.1f ms)\n",
+              o.output.c_str(), bs.width, bs.height, o.beam_order.c_str(), bs.max_depth, bs.accel.c_str(),
+              device.info().name.c_str(), st.polygons, st.tiles, st.reflected_beams, st.levels, st.candidates,
+              st.fragments, st.pixel_pieces, st.shadow_rays, st.render_ms * 1e-3, st.clip_ms);
 }
 
 // --method selective | wavelet: the image, and its summary line.
@@ -260,9 +262,9 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("--method", o->method,
                   "ray: trace every pixel; selective: trace block corners, subdivide blocks whose corners differ, "
                   "interpolate the rest; wavelet: a coarse pass, then whole blocks where its Haar coefficients are "
-                  "large, under --wavelet-budget (speed/accuracy); beam: beam tracing of the primary visibility "
-                  "(polygons and point lights only; exact pixel coverage, --spp and the samplers do not apply; no "
-                  "reflection or refraction beams)")
+                  "large, under --wavelet-budget (speed/accuracy); beam: beam tracing with reflection beams to --depth "
+                  "(polygons, point lights and mirrors only; exact pixel coverage, --spp and the samplers do not "
+                  "apply)")
       ->capture_default_str()
       ->check(CLI::IsMember({"ray", "selective", "wavelet", "beam"}));
   cmd->add_option("--selective-block", o->selective_block,

@@ -28,9 +28,9 @@ struct RenderOptions {
   // selective: block corners traced, blocks subdivided where they differ,
   // the rest interpolated; wavelet: a coarse pass, then whole blocks where
   // its Haar coefficients are large, under a budget (rtcl/render/
-  // selective.hpp, wavelet.hpp); beam: beam tracing of the primary
-  // visibility (src/rtcl/beam/beam_renderer.hpp), with the depth order of
-  // its walk (exact | key).
+  // selective.hpp, wavelet.hpp); beam: beam tracing with reflection beams
+  // (src/rtcl/beam/beam_renderer.hpp), with the depth order of its walk
+  // (exact | key).
   std::string method = "ray";
   std::string beam_order = "exact";
   std::uint32_t selective_block = 8;

@@ -2,13 +2,19 @@
 
 namespace rtcl::beam {
 
-std::vector<HostFragment> clip_beams_host(const std::vector<ScreenPolygon>& polygons, const TileBeams& tb,
+Convex cross_section(const Beam& b) {
+  Convex c;
+  for (std::uint32_t k = 0; k < b.vertex_count && k < RTCL_BEAM_PIECE_VERTS; ++k) c.v.push_back({b.x[k], b.y[k]});
+  return c;
+}
+
+std::vector<HostFragment> clip_beams_host(const std::vector<ScreenPolygon>& polygons, const BeamSet& tb,
                                           DepthOrder order) {
   std::vector<HostFragment> out;
-  for (std::uint32_t ti = 0; ti < tb.tiles.size(); ++ti) {
-    const BeamTile& t = tb.tiles[ti];
-    const double min_area = beam_min_area_fraction * double(t.w) * t.h;
-    Region beam{rectangle(t.x0, t.y0, double(t.x0) + t.w, double(t.y0) + t.h)};
+  for (std::uint32_t ti = 0; ti < tb.beams.size(); ++ti) {
+    const Beam& t = tb.beams[ti];
+    Region beam{cross_section(t)};
+    const double min_area = beam_min_area_fraction * area(beam);
     for (std::uint32_t c = 0; c < t.count && !beam.empty(); ++c) {
       const ScreenPolygon& p = polygons[tb.candidates[t.first + c]];
       const Convex poly{p.v};

@@ -1,4 +1,4 @@
-// Beam clipping of tile beams on the host in double precision: the reference
+// Beam clipping of beams on the host in double precision: the reference
 // the device kernel (kernels/render/beam_clip.cl) is tested against, the same
 // walk in the same order. Per tile beam (lecture, 反射光束跟踪过程（2）): walk
 // the candidates front to back; fragment = beam ∩ polygon; record it;
@@ -29,14 +29,17 @@ enum class DepthOrder {
 };
 
 struct HostFragment {
-  std::uint32_t tile = 0, polygon = 0;  // indexes into TileBeams::tiles and the polygon list
+  std::uint32_t beam = 0, polygon = 0;  // indexes into BeamSet::beams and the polygon list
   Convex piece;                         // pixels
 };
 
-// Fragments in the kernel's output order (per tile: walking order, then
+// The beam's cross-section as stored (float vertices, exactly in double).
+Convex cross_section(const Beam& beam);
+
+// Fragments in the kernel's output order (per beam: walking order, then
 // beam piece order, then fragment piece order). Pieces below
-// beam_min_area_fraction of the tile's area are dropped.
-std::vector<HostFragment> clip_beams_host(const std::vector<ScreenPolygon>& polygons, const TileBeams& tiles,
+// beam_min_area_fraction of the beam's area are dropped.
+std::vector<HostFragment> clip_beams_host(const std::vector<ScreenPolygon>& polygons, const BeamSet& beams,
                                           DepthOrder order);
 
 }  // namespace rtcl::beam

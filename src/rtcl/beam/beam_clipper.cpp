@@ -32,15 +32,15 @@ std::vector<BeamPolygon> pack(const std::vector<ScreenPolygon>& polygons) {
 }  // namespace
 
 std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vector<ScreenPolygon>& polygons,
-                                            const TileBeams& tb, DepthOrder order, DeviceClipStats* stats) {
+                                            const BeamSet& tb, DepthOrder order, DeviceClipStats* stats) {
   DeviceClipStats st;
-  if (tb.tiles.empty()) return {};
+  if (tb.beams.empty()) return {};
   std::vector<BeamPolygon> packed = pack(polygons);
   if (packed.empty()) packed.push_back(BeamPolygon{});  // no zero-sized buffers
   std::vector<std::uint32_t> candidates = tb.candidates;
   if (candidates.empty()) candidates.push_back(0);
   cl::Buffer polys = device.upload(packed.data(), packed.size() * sizeof(BeamPolygon), "beam polygons");
-  cl::Buffer tiles = device.upload(tb.tiles.data(), tb.tiles.size() * sizeof(BeamTile), "beam tiles");
+  cl::Buffer tiles = device.upload(tb.beams.data(), tb.beams.size() * sizeof(Beam), "beams");
   cl::Buffer cands = device.upload(candidates.data(), candidates.size() * sizeof(std::uint32_t), "beam candidates");
   cl::Program program = device.program("render/beam_clip.cl", {});
   cl::Kernel kernel(program, "clip_beams");
@@ -57,7 +57,7 @@ std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vec
     kernel.setArg(a++, polys);
     kernel.setArg(a++, tiles);
     kernel.setArg(a++, cands);
-    kernel.setArg(a++, static_cast<cl_uint>(tb.tiles.size()));
+    kernel.setArg(a++, static_cast<cl_uint>(tb.beams.size()));
     kernel.setArg(a++, static_cast<cl_uint>(order == DepthOrder::exact));
     kernel.setArg(a++, device_min_area_fraction);
     kernel.setArg(a++, frags);
@@ -67,7 +67,7 @@ std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vec
     // A small work-group: each work-item holds four regions of pieces
     // (about 17 KB) in private memory, which PoCL replicates per work-item
     // of a group on one thread's stack.
-    const std::size_t group = 4, global = (tb.tiles.size() + group - 1) / group * group;
+    const std::size_t group = 4, global = (tb.beams.size() + group - 1) / group * group;
     check_cl(device.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(group),
                                                  nullptr, &done),
              "clEnqueueNDRangeKernel(clip_beams)");
@@ -78,14 +78,14 @@ std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vec
       st.clip_ms += (done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
                      done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6;
     if (status[RTCL_BEAM_STATUS_PIECE_OVERFLOW] || status[RTCL_BEAM_STATUS_VERT_OVERFLOW]) {
-      const BeamTile& t = tb.tiles[std::min<std::size_t>(status[RTCL_BEAM_STATUS_FIRST_TILE], tb.tiles.size() - 1)];
-      throw Error("beam clipping: the tile beam at pixel (" + std::to_string(t.x0) + ", " + std::to_string(t.y0) +
+      const Beam& t = tb.beams[std::min<std::size_t>(status[RTCL_BEAM_STATUS_FIRST_TILE], tb.beams.size() - 1)];
+      throw Error("beam clipping: the beam at pixel (" + std::to_string(int(t.x0)) + ", " + std::to_string(int(t.y0)) +
                   ") " +
                   (status[RTCL_BEAM_STATUS_PIECE_OVERFLOW]
                        ? "needs more than " + std::to_string(RTCL_BEAM_MAX_PIECES) + " convex pieces"
                        : "has a piece of more than " + std::to_string(RTCL_BEAM_PIECE_VERTS) + " vertices") +
                   " (" + std::to_string(status[RTCL_BEAM_STATUS_PIECE_OVERFLOW] + status[RTCL_BEAM_STATUS_VERT_OVERFLOW]) +
-                  " tile beams over the limit; RTCL_BEAM_MAX_PIECES / RTCL_BEAM_PIECE_VERTS in "
+                  " beams over the limit; RTCL_BEAM_MAX_PIECES / RTCL_BEAM_PIECE_VERTS in "
                   "kernels/shared/beam_layouts.h)");
     }
     std::size_t wanted = status[RTCL_BEAM_STATUS_FRAGMENTS];
@@ -104,7 +104,7 @@ std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vec
     break;
   }
   std::sort(out.begin(), out.end(), [](const BeamFragment& a, const BeamFragment& b) {
-    return a.tile != b.tile ? a.tile < b.tile : a.seq < b.seq;
+    return a.beam != b.beam ? a.beam < b.beam : a.seq < b.seq;
   });
   st.fragments = out.size();
   if (stats) *stats = st;

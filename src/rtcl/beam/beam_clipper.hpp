@@ -1,5 +1,6 @@
-// Beam clipping on the OpenCL device (kernels/render/beam_clip.cl): all tile
-// beams of the screen in one launch, one work-item per tile beam.
+// Beam clipping on the OpenCL device (kernels/render/beam_clip.cl): all beams
+// of a set (the tiles of the screen, or one level of the beam tree) in one
+// launch, one work-item per beam.
 #pragma once
 
 #include <cstdint>
@@ -13,9 +14,9 @@
 
 namespace rtcl::beam {
 
-// The float kernel drops pieces below this fraction of the tile's area:
-// float rounding of tile-local coordinates (<= the tile's side, 2^-24
-// relative) makes areas uncertain by about 1e-6 of the tile's; far below any
+// The float kernel drops pieces below this fraction of the beam's area:
+// float rounding of beam-local coordinates (<= the beam's size, 2^-24
+// relative) makes areas uncertain by about 1e-6 of the beam's; far below any
 // visible coverage.
 inline constexpr float device_min_area_fraction = 1e-6f;
 
@@ -25,13 +26,13 @@ struct DeviceClipStats {
   std::size_t launches = 0;         // 2 when the fragment buffer had to grow
 };
 
-// Fragments as the device wrote them, sorted by (tile, seq): the host
-// reference's order. Throws Error naming the tile and the limit when a beam
+// Fragments as the device wrote them, sorted by (beam, seq): the host
+// reference's order. Throws Error naming the beam and the limit when a beam
 // needs more than RTCL_BEAM_MAX_PIECES pieces or a piece more than
 // RTCL_BEAM_PIECE_VERTS vertices, and when the fragments do not fit in the
 // device's memory (after one retry with a buffer of the size counted).
 std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vector<ScreenPolygon>& polygons,
-                                            const TileBeams& tiles, DepthOrder order,
+                                            const BeamSet& beams, DepthOrder order,
                                             DeviceClipStats* stats = nullptr);
 
 }  // namespace rtcl::beam

@@ -4,9 +4,12 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/beam/beam_clipper.hpp"
+#include "rtcl/beam/mirror.hpp"
 #include "rtcl/beam/polygon2d.hpp"
 #include "rtcl/beam/screen_space.hpp"
 #include "rtcl/beam/tile_beams.hpp"
@@ -22,9 +25,10 @@ using glm::dvec3;
 
 // One fragment's share of one pixel.
 struct PixelPiece {
-  std::uint32_t pixel, polygon;
+  std::uint32_t pixel, polygon, world;
   double area;
   dvec2 centroid;
+  dvec3 weight;  // product of kr down the beam tree
 };
 
 dvec2 centroid(const Convex& c, double a) {
@@ -38,48 +42,127 @@ dvec2 centroid(const Convex& c, double a) {
   return sum / (6.0 * a);
 }
 
+// One world of the beam tree: the scene moved by the product of its
+// mirrors' M_r, its screen polygons polygons[first .. first + count).
+struct World {
+  glm::dmat4 to_virtual{1.0}, to_real{1.0};
+  std::uint32_t first = 0, count = 0;
+};
+
+struct BeamInfo {
+  std::uint32_t world;
+  dvec3 weight;
+  std::uint32_t depth;
+};
+
 struct Visible {
   ScreenSpace screen;
   std::vector<ScreenPolygon> polygons;
+  std::vector<World> worlds;
   std::vector<PixelPiece> pieces;
+  std::vector<dvec3> background_weight;  // per pixel: weighted area of beams that meet nothing
   BeamStats stats;
 };
 
-// Exact coverage: each fragment piece against the pixel squares of its box.
-Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene& flat, const BeamSettings& s) {
-  Visible v;
-  v.screen = screen_space(camera_frame(scene.camera, s.width, s.height), s.width, s.height, flat.geometry);
-  v.polygons = screen_polygons(v.screen, flat.geometry);
-  TileBeams tiles = tile_beams(v.polygons, s.width, s.height);
-  DeviceClipStats cs;
-  std::vector<BeamFragment> frags = clip_beams_device(device, v.polygons, tiles, s.order, &cs);
-  v.stats.polygons = v.polygons.size();
-  v.stats.tiles = tiles.tiles.size();
-  v.stats.candidates = tiles.candidates.size();
-  v.stats.fragments = frags.size();
-  v.stats.clip_ms = cs.clip_ms;
-  for (const BeamFragment& f : frags) {
-    const BeamTile& t = tiles.tiles[f.tile];
-    Convex piece;
-    for (std::uint32_t k = 0; k < f.count; ++k) piece.v.push_back({f.x[k], f.y[k]});
-    dvec2 lo(INFINITY), hi(-INFINITY);
-    for (const dvec2& p : piece.v) {
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
+Convex piece_of(const BeamFragment& f) {
+  Convex c;
+  for (std::uint32_t k = 0; k < f.count; ++k) c.v.push_back({f.x[k], f.y[k]});
+  return c;
+}
+
+// Calls out(pixel, area, centroid) for every pixel square `piece` meets.
+template <class Out>
+void rasterise(const Convex& piece, std::uint32_t width, std::uint32_t height, Out out) {
+  dvec2 lo(INFINITY), hi(-INFINITY);
+  for (const dvec2& p : piece.v) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  auto px0 = std::uint32_t(std::clamp(std::floor(lo.x), 0.0, double(width - 1)));
+  auto px1 = std::uint32_t(std::clamp(std::floor(hi.x), 0.0, double(width - 1)));
+  auto py0 = std::uint32_t(std::clamp(std::floor(lo.y), 0.0, double(height - 1)));
+  auto py1 = std::uint32_t(std::clamp(std::floor(hi.y), 0.0, double(height - 1)));
+  for (std::uint32_t y = py0; y <= py1; ++y)
+    for (std::uint32_t x = px0; x <= px1; ++x) {
+      Convex c = intersect(piece, rectangle(x, y, x + 1.0, y + 1.0));
+      if (c.v.size() < 3) continue;
+      double a = signed_area(c.v);
+      if (a > 0.0) out(y * width + x, a, centroid(c, a));
     }
-    // Within its tile: fragments never leave it (float rounding clamped).
-    auto px0 = std::uint32_t(std::clamp(std::floor(lo.x), double(t.x0), double(t.x0 + t.w - 1)));
-    auto px1 = std::uint32_t(std::clamp(std::floor(hi.x), double(t.x0), double(t.x0 + t.w - 1)));
-    auto py0 = std::uint32_t(std::clamp(std::floor(lo.y), double(t.y0), double(t.y0 + t.h - 1)));
-    auto py1 = std::uint32_t(std::clamp(std::floor(hi.y), double(t.y0), double(t.y0 + t.h - 1)));
-    for (std::uint32_t y = py0; y <= py1; ++y)
-      for (std::uint32_t x = px0; x <= px1; ++x) {
-        Convex c = intersect(piece, rectangle(x, y, x + 1.0, y + 1.0));
-        if (c.v.size() < 3) continue;
-        double a = signed_area(c.v);
-        if (!(a > 0.0)) continue;
-        v.pieces.push_back({y * s.width + x, f.polygon, a, centroid(c, a)});
+}
+
+// The beam tree, level by level: one device launch per level.
+Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene& flat, const BeamSettings& s,
+                       bool primary_only = false) {
+  Visible v;
+  const Geometry& g = flat.geometry;
+  v.screen = screen_space(camera_frame(scene.camera, s.width, s.height), s.width, s.height, g);
+  v.polygons = screen_polygons(v.screen, g);
+  v.worlds.push_back(World{glm::dmat4(1.0), glm::dmat4(1.0), 0, std::uint32_t(v.polygons.size())});
+  v.background_weight.assign(std::size_t(s.width) * s.height, dvec3(0.0));
+  const double reach = v.screen.near / near_fraction;
+  BeamSet level = tile_beams(v.polygons, s.width, s.height);
+  std::vector<BeamInfo> info(level.beams.size(), BeamInfo{0, dvec3(1.0), 0});
+  v.stats.polygons = v.polygons.size();
+  v.stats.tiles = level.beams.size();
+  // Every beam's area starts as background; each fragment takes its share back.
+  for (const Beam& b : level.beams)
+    rasterise(cross_section(b), s.width, s.height,
+              [&](std::uint32_t px, double a, dvec2) { v.background_weight[px] += a * dvec3(1.0); });
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> world_of;  // (parent world, mirror prim)
+  while (!level.beams.empty()) {
+    ++v.stats.levels;
+    v.stats.candidates += level.candidates.size();
+    DeviceClipStats cs;
+    std::vector<BeamFragment> frags = clip_beams_device(device, v.polygons, level, s.order, &cs);
+    v.stats.fragments += frags.size();
+    v.stats.clip_ms += cs.clip_ms;
+    BeamSet next;
+    std::vector<BeamInfo> next_info;
+    std::vector<Convex> next_sections;
+    for (const BeamFragment& f : frags) {
+      const BeamInfo& bi = info[f.beam];
+      const ScreenPolygon& sp = v.polygons[f.polygon];
+      Convex piece = piece_of(f);
+      rasterise(piece, s.width, s.height, [&](std::uint32_t px, double a, dvec2 c) {
+        v.pieces.push_back({px, f.polygon, bi.world, a, c, bi.weight});
+        v.background_weight[px] -= a * bi.weight;
+      });
+      const Material& m = scene.materials[flat.material[sp.prim]];
+      if (primary_only || !m.reflective() || bi.depth >= s.max_depth) continue;
+      dvec3 w = bi.weight * dvec3(m.kr);
+      if (!(std::max({w.x, w.y, w.z}) >= double(s.min_weight)) || !(std::max({w.x, w.y, w.z}) > 0.0)) continue;
+      auto key = std::make_pair(bi.world, sp.prim);
+      auto it = world_of.find(key);
+      if (it == world_of.end()) {
+        const World parent = v.worlds[bi.world];
+        const glm::uvec3& t = g.triangles[sp.prim];
+        auto moved = [&](std::uint32_t i) { return dvec3(parent.to_virtual * glm::dvec4(dvec3(g.vertices[i]), 1.0)); };
+        glm::dvec4 L = plane_through(moved(t.x), moved(t.y), moved(t.z));
+        World child;
+        child.to_virtual = reflection_matrix(L) * parent.to_virtual;
+        child.to_real = glm::inverse(child.to_virtual);
+        // Keep the far side of the mirror from the eye (the mirror maps to itself).
+        glm::dvec4 keep = glm::dot(L, glm::dvec4(v.screen.frame.origin, 1.0)) > 0.0 ? -L : L;
+        std::vector<ScreenPolygon> polys = screen_polygons(v.screen, g, child.to_virtual, &keep, 1e-9 * reach);
+        child.first = std::uint32_t(v.polygons.size());
+        child.count = std::uint32_t(polys.size());
+        v.polygons.insert(v.polygons.end(), polys.begin(), polys.end());
+        it = world_of.emplace(key, std::uint32_t(v.worlds.size())).first;
+        v.worlds.push_back(child);
       }
+      next_sections.push_back(piece);
+      next_info.push_back(BeamInfo{it->second, w, bi.depth + 1});
+    }
+    for (std::size_t i = 0; i < next_sections.size(); ++i) {
+      const World& wd = v.worlds[next_info[i].world];
+      add_beam(next, next_sections[i], v.polygons, wd.first, wd.count);
+      rasterise(next_sections[i], s.width, s.height,
+                [&](std::uint32_t px, double a, dvec2) { v.background_weight[px] += a * next_info[i].weight; });
+    }
+    v.stats.reflected_beams += next.beams.size();
+    level = std::move(next);
+    info = std::move(next_info);
   }
   v.stats.pixel_pieces = v.pieces.size();
   return v;
@@ -97,13 +180,17 @@ void check_beam_scene(const Scene& scene) {
     if (scene.lights[i].area())
       throw Error(scene.source + ": light " + std::to_string(i) +
                   " is an area light; --method beam shades with point lights only (use --method ray)");
+  for (const Material& m : scene.materials)
+    if (m.transmissive() || m.glossy())
+      throw Error(scene.source + ": material '" + m.name + "' is " + (m.transmissive() ? "transmissive" : "glossy") +
+                  "; --method beam traces mirror reflection only (use --method ray)");
 }
 
 std::vector<CoverageEntry> beam_coverage(const Device& device, const Scene& scene, const BeamSettings& settings) {
   check_beam_scene(scene);
   validate(scene);
   FlatScene flat = flatten(scene);
-  Visible v = visible_pieces(device, scene, flat, settings);
+  Visible v = visible_pieces(device, scene, flat, settings, true);
   std::vector<CoverageEntry> out;
   for (const PixelPiece& p : v.pieces) out.push_back({p.pixel, v.polygons[p.polygon].prim, p.area});
   return out;
@@ -134,8 +221,10 @@ Image render_beam(const Device& device, const Scene& scene, const BeamSettings& 
     dvec3 a(g.vertices[tri.x]), b(g.vertices[tri.y]), c(g.vertices[tri.z]);
     dvec3 e1 = b - a, e2 = c - a;
     Point& pt = points[i];
-    pt.p = unproject(v.screen, sp.inv_depth, pp.centroid);
-    pt.view = glm::normalize(pt.p - v.screen.frame.origin);
+    const World& wd = v.worlds[pp.world];
+    dvec3 pv = unproject(v.screen, sp.inv_depth, pp.centroid);  // in the beam's (virtual) world
+    pt.p = dvec3(wd.to_real * glm::dvec4(pv, 1.0));
+    pt.view = glm::normalize(glm::dmat3(wd.to_real) * (pv - v.screen.frame.origin));
     dvec3 ng = glm::normalize(glm::cross(e1, e2));
     pt.n = glm::dot(ng, pt.view) < 0.0 ? ng : -ng;
     double extent = std::max(max_abs3(e1), max_abs3(e2));
@@ -169,7 +258,7 @@ Image render_beam(const Device& device, const Scene& scene, const BeamSettings& 
   Image img;
   img.width = settings.width;
   img.height = settings.height;
-  std::vector<double> rgb(std::size_t(img.width) * img.height * 3, 0.0), covered(std::size_t(img.width) * img.height, 0.0);
+  std::vector<double> rgb(std::size_t(img.width) * img.height * 3, 0.0);
   for (std::size_t i = 0; i < v.pieces.size(); ++i) {
     const PixelPiece& pp = v.pieces[i];
     const Point& pt = points[i];
@@ -187,14 +276,13 @@ Image render_beam(const Device& device, const Scene& scene, const BeamSettings& 
       }
       L += dvec3(lights[l].color) * double(lights[l].intensity) * f;
     }
-    for (int k = 0; k < 3; ++k) rgb[pp.pixel * 3 + k] += pp.area * L[k];
-    covered[pp.pixel] += pp.area;
+    for (int k = 0; k < 3; ++k) rgb[pp.pixel * 3 + k] += pp.area * pp.weight[k] * L[k];
   }
   img.rgb.resize(rgb.size());
-  for (std::size_t p = 0; p < covered.size(); ++p)
+  for (std::size_t p = 0; p < v.background_weight.size(); ++p)
     for (int k = 0; k < 3; ++k)
       img.rgb[p * 3 + k] =
-          float(rgb[p * 3 + k] + std::max(0.0, 1.0 - covered[p]) * double(scene.background[k]));
+          float(rgb[p * 3 + k] + std::max(0.0, v.background_weight[p][k]) * double(scene.background[k]));
   BeamStats st = v.stats;
   st.shadow_rays = shadow.size();
   st.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -60,6 +60,28 @@ Convex make_convex(std::vector<dvec2> vertices) {
   return Convex{std::move(vertices)};
 }
 
+Convex make_strictly_convex(const Convex& polygon, double merge) {
+  std::vector<dvec2> v = polygon.v;
+  bool changed = true;
+  while (changed && v.size() >= 3) {
+    changed = false;
+    for (std::size_t i = 0; i < v.size() && v.size() >= 3; ++i) {
+      const dvec2& a = v[(i + v.size() - 1) % v.size()];
+      const dvec2& b = v[i];
+      const dvec2& c = v[(i + 1) % v.size()];
+      dvec2 d = glm::abs(b - a);
+      double turn = (b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x);
+      if (std::max(d.x, d.y) <= merge || !(turn > 0.0)) {
+        v.erase(v.begin() + static_cast<std::ptrdiff_t>(i));
+        changed = true;
+        break;
+      }
+    }
+  }
+  if (v.size() < 3) v.clear();
+  return Convex{std::move(v)};
+}
+
 Convex rectangle(double x0, double y0, double x1, double y1) {
   return Convex{{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}};
 }
@@ -110,6 +132,7 @@ Region subtract(const Convex& polygon, const Convex& convex, double min_area) {
   const std::size_t n = convex.v.size();
   for (std::size_t i = 0; i < n; ++i) {
     HalfPlane h = edge_half_plane(convex.v[i], convex.v[(i + 1) % n]);
+    if (h.a == 0.0 && h.b == 0.0) continue;  // a zero-length edge bounds nothing
     // Outside edge i and inside edges 0 .. i-1: disjoint from the others.
     Convex outside = clip(rest, HalfPlane{-h.a, -h.b, -h.c});
     if (!empty(outside) && signed_area(outside.v) >= min_area) out.push_back(std::move(outside));

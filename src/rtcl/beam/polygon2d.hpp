@@ -41,6 +41,11 @@ double area(const Region& region);
 // The convex polygon through `vertices` in either orientation, made
 // counter-clockwise; consecutive duplicates removed. No convexity check.
 Convex make_convex(std::vector<glm::dvec2> vertices);
+// A polygon meant to be convex made strictly convex: vertices within `merge`
+// (max norm) of their predecessor, and vertices where the boundary does not
+// turn left (collinear, or reflex by rounding, e.g. a spike of two
+// near-copies of one vertex after clipping), are removed until none is left.
+Convex make_strictly_convex(const Convex& polygon, double merge);
 // Axis-aligned rectangle [x0, x1] x [y0, y1].
 Convex rectangle(double x0, double y0, double x1, double y1);
 

@@ -43,7 +43,26 @@ dvec3 unproject(const ScreenSpace& screen, const dvec3& inv_depth, const dvec2& 
   return f.origin + s * (f.corner + xy.x * f.du + xy.y * f.dv);
 }
 
-std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geometry& geometry) {
+namespace {
+
+// Sutherland–Hodgman of a 3D polygon against dist(p) >= 0.
+template <class Dist>
+std::vector<dvec3> clip3(const std::vector<dvec3>& in, Dist dist) {
+  std::vector<dvec3> out;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const dvec3 &a = in[i], &b = in[(i + 1) % in.size()];
+    double da = dist(a), db = dist(b);
+    if (da >= 0.0) out.push_back(a);
+    if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) out.push_back(a + (da / (da - db)) * (b - a));
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geometry& geometry,
+                                           const glm::dmat4& to_world, const glm::dvec4* keep_plane,
+                                           double keep_margin) {
   const CameraFrame& f = screen.frame;
   const double screen_area = double(screen.width) * screen.height;
   // One pixel of margin: fragments never reach the screen's border by rounding.
@@ -51,23 +70,21 @@ std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geom
   std::vector<ScreenPolygon> out;
   for (std::size_t t = 0; t < geometry.triangles.size(); ++t) {
     dvec3 v[3];
-    for (int k = 0; k < 3; ++k) v[k] = dvec3(geometry.vertices[geometry.triangles[t][k]]);
+    for (int k = 0; k < 3; ++k) v[k] = dvec3(to_world * glm::dvec4(dvec3(geometry.vertices[geometry.triangles[t][k]]), 1.0));
     dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
     double k = glm::dot(n, v[0] - f.origin);
     if (!(std::abs(k) > 0.0)) continue;  // zero area, or its plane holds the eye: seen edge-on
-    // Near plane s >= near, in world space before the divide (Sutherland–Hodgman on depth).
-    std::vector<dvec3> clipped;
-    for (int i = 0; i < 3; ++i) {
-      const dvec3 &a = v[i], &b = v[(i + 1) % 3];
-      double da = glm::dot(a - f.origin, screen.forward) - screen.near;
-      double db = glm::dot(b - f.origin, screen.forward) - screen.near;
-      if (da >= 0.0) clipped.push_back(a);
-      if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) clipped.push_back(a + (da / (da - db)) * (b - a));
-    }
+    // Near plane s >= near, in world space before the divide.
+    std::vector<dvec3> clipped =
+        clip3({v[0], v[1], v[2]}, [&](const dvec3& p) { return glm::dot(p - f.origin, screen.forward) - screen.near; });
+    if (keep_plane)
+      clipped = clip3(clipped, [&](const dvec3& p) { return glm::dot(*keep_plane, glm::dvec4(p, 1.0)) - keep_margin; });
     if (clipped.size() < 3) continue;
     std::vector<dvec2> projected;
     for (const dvec3& p : clipped) projected.push_back(project(screen, p));
-    Convex c = intersect(make_convex(projected), rect);
+    // Clipping leaves near-copies of a vertex (a spike, reflex by rounding)
+    // where a plane passes through it: merged at 1e-9 of the screen's size.
+    Convex c = make_strictly_convex(intersect(make_convex(projected), rect), 1e-9 * (screen.width + screen.height));
     if (c.v.size() < 3 || signed_area(c.v) < 1e-12 * screen_area) continue;
     ScreenPolygon sp;
     sp.v = std::move(c.v);

@@ -15,7 +15,7 @@
 namespace rtcl::beam {
 
 struct ScreenPolygon {
-  std::vector<glm::dvec2> v;  // pixels, x right, y down; counter-clockwise in (x, y); 3 .. 8 vertices
+  std::vector<glm::dvec2> v;  // pixels, x right, y down; strictly convex, counter-clockwise in (x, y); 3 .. 8 vertices
   // 1 / s = inv_depth.x * x + inv_depth.y * y + inv_depth.z over the
   // triangle's plane, s the depth along the view direction (scene units).
   glm::dvec3 inv_depth{0.0};
@@ -43,6 +43,14 @@ glm::dvec3 unproject(const ScreenSpace& screen, const glm::dvec3& inv_depth, con
 // near plane, outside the screen, seen edge-on or of projected area below
 // 1e-12 of the screen are left out. Spheres are not polygons: the caller
 // refuses them (render/beam_renderer.hpp).
-std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geometry& geometry);
+//
+// A reflected beam's world (mirror.hpp): every vertex is first moved by
+// `to_world` (the product of the beam tree's mirror transforms), and the
+// triangles are clipped, like by the near plane, to keep_plane . (p, 1) >=
+// keep_margin (the far side of the last mirror; the margin, in scene units,
+// drops the mirror itself and polygons in its plane).
+std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geometry& geometry,
+                                           const glm::dmat4& to_world = glm::dmat4(1.0),
+                                           const glm::dvec4* keep_plane = nullptr, double keep_margin = 0.0);
 
 }  // namespace rtcl::beam

@@ -2,62 +2,106 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
-#include "rtcl/beam/polygon2d.hpp"
+#include "rtcl/error.hpp"
 
 namespace rtcl::beam {
 
-TileBeams tile_beams(const std::vector<ScreenPolygon>& polygons, std::uint32_t width, std::uint32_t height,
-                     std::uint32_t tile_px) {
-  TileBeams tb;
-  tb.tile_px = tile_px;
-  tb.columns = (width + tile_px - 1) / tile_px;
-  tb.rows = (height + tile_px - 1) / tile_px;
-  struct Candidate {
+namespace {
+
+struct Candidate {
+  double key;
+  std::uint32_t polygon;
+};
+
+struct Box2 {
+  glm::dvec2 lo{INFINITY}, hi{-INFINITY};
+};
+Box2 box_of(const std::vector<glm::dvec2>& v) {
+  Box2 b;
+  for (const glm::dvec2& p : v) {
+    b.lo = glm::min(b.lo, p);
+    b.hi = glm::max(b.hi, p);
+  }
+  return b;
+}
+
+// The candidate record of polygon p for a beam, or none.
+bool candidate(const ScreenPolygon& sp, const Convex& section, double min_area, double* key) {
+  Convex part = intersect(Convex{sp.v}, section);
+  if (part.v.size() < 3 || signed_area(part.v) < min_area) return false;
+  *key = -INFINITY;
+  for (const glm::dvec2& v : part.v) *key = std::max(*key, sp.inv_depth.x * v.x + sp.inv_depth.y * v.y + sp.inv_depth.z);
+  return true;
+}
+
+void push_beam(BeamSet& set, const Convex& section, std::vector<Candidate>& list) {
+  if (section.v.size() < 3 || section.v.size() > RTCL_BEAM_PIECE_VERTS)
+    throw Error("beam: a beam's cross-section has " + std::to_string(section.v.size()) + " vertices (3 .. " +
+                std::to_string(RTCL_BEAM_PIECE_VERTS) + ")");
+  std::sort(list.begin(), list.end(), [](const Candidate& a, const Candidate& b) {
+    return a.key != b.key ? a.key > b.key : a.polygon < b.polygon;
+  });
+  Beam b{};
+  Box2 box = box_of(section.v);
+  b.x0 = static_cast<float>(std::floor(box.lo.x));
+  b.y0 = static_cast<float>(std::floor(box.lo.y));
+  b.vertex_count = static_cast<rtcl_u32>(section.v.size());
+  for (std::size_t k = 0; k < section.v.size(); ++k) {
+    b.x[k] = static_cast<float>(section.v[k].x);
+    b.y[k] = static_cast<float>(section.v[k].y);
+  }
+  b.first = static_cast<rtcl_u32>(set.candidates.size());
+  b.count = static_cast<rtcl_u32>(list.size());
+  for (const Candidate& c : list) set.candidates.push_back(c.polygon);
+  set.beams.push_back(b);
+}
+
+}  // namespace
+
+void add_beam(BeamSet& set, const Convex& section, const std::vector<ScreenPolygon>& polygons, std::uint32_t first,
+              std::uint32_t count) {
+  const double min_area = beam_min_area_fraction * signed_area(section.v);
+  Box2 box = box_of(section.v);
+  std::vector<Candidate> list;
+  for (std::uint32_t p = first; p < first + count; ++p) {
+    Box2 pb = box_of(polygons[p].v);
+    if (pb.hi.x < box.lo.x || box.hi.x < pb.lo.x || pb.hi.y < box.lo.y || box.hi.y < pb.lo.y) continue;
     double key;
-    std::uint32_t polygon;
+    if (candidate(polygons[p], section, min_area, &key)) list.push_back({key, p});
+  }
+  push_beam(set, section, list);
+}
+
+BeamSet tile_beams(const std::vector<ScreenPolygon>& polygons, std::uint32_t width, std::uint32_t height,
+                   std::uint32_t tile_px) {
+  BeamSet set;
+  set.tile_px = tile_px;
+  set.columns = (width + tile_px - 1) / tile_px;
+  set.rows = (height + tile_px - 1) / tile_px;
+  std::vector<std::vector<Candidate>> lists(std::size_t(set.columns) * set.rows);
+  auto section_of = [&](std::uint32_t tx, std::uint32_t ty) {
+    double x0 = double(tx) * tile_px, y0 = double(ty) * tile_px;
+    return rectangle(x0, y0, std::min<double>(x0 + tile_px, width), std::min<double>(y0 + tile_px, height));
   };
-  std::vector<std::vector<Candidate>> lists(std::size_t(tb.columns) * tb.rows);
   for (std::uint32_t p = 0; p < polygons.size(); ++p) {
-    const ScreenPolygon& sp = polygons[p];
-    glm::dvec2 lo(INFINITY), hi(-INFINITY);
-    for (const glm::dvec2& v : sp.v) {
-      lo = glm::min(lo, v);
-      hi = glm::max(hi, v);
-    }
+    Box2 b = box_of(polygons[p].v);
     auto first = [&](double c, std::uint32_t n) {
       return static_cast<std::uint32_t>(std::clamp(std::floor(c / tile_px), 0.0, double(n - 1)));
     };
-    Convex poly{sp.v};
-    for (std::uint32_t ty = first(lo.y, tb.rows); ty <= first(hi.y, tb.rows); ++ty)
-      for (std::uint32_t tx = first(lo.x, tb.columns); tx <= first(hi.x, tb.columns); ++tx) {
-        double x0 = double(tx) * tile_px, y0 = double(ty) * tile_px;
-        double x1 = std::min<double>(x0 + tile_px, width), y1 = std::min<double>(y0 + tile_px, height);
-        Convex part = intersect(poly, rectangle(x0, y0, x1, y1));
-        if (part.v.size() < 3 || signed_area(part.v) < beam_min_area_fraction * (x1 - x0) * (y1 - y0)) continue;
-        double key = -INFINITY;
-        for (const glm::dvec2& v : part.v)
-          key = std::max(key, sp.inv_depth.x * v.x + sp.inv_depth.y * v.y + sp.inv_depth.z);
-        lists[std::size_t(ty) * tb.columns + tx].push_back({key, p});
+    for (std::uint32_t ty = first(b.lo.y, set.rows); ty <= first(b.hi.y, set.rows); ++ty)
+      for (std::uint32_t tx = first(b.lo.x, set.columns); tx <= first(b.hi.x, set.columns); ++tx) {
+        Convex section = section_of(tx, ty);
+        double key;
+        if (candidate(polygons[p], section, beam_min_area_fraction * signed_area(section.v), &key))
+          lists[std::size_t(ty) * set.columns + tx].push_back({key, p});
       }
   }
-  for (std::uint32_t ty = 0; ty < tb.rows; ++ty)
-    for (std::uint32_t tx = 0; tx < tb.columns; ++tx) {
-      auto& list = lists[std::size_t(ty) * tb.columns + tx];
-      std::sort(list.begin(), list.end(), [](const Candidate& a, const Candidate& b) {
-        return a.key != b.key ? a.key > b.key : a.polygon < b.polygon;
-      });
-      BeamTile t;
-      t.x0 = tx * tile_px;
-      t.y0 = ty * tile_px;
-      t.w = std::min(tile_px, width - t.x0);
-      t.h = std::min(tile_px, height - t.y0);
-      t.first = static_cast<std::uint32_t>(tb.candidates.size());
-      t.count = static_cast<std::uint32_t>(list.size());
-      for (const Candidate& c : list) tb.candidates.push_back(c.polygon);
-      tb.tiles.push_back(t);
-    }
-  return tb;
+  for (std::uint32_t ty = 0; ty < set.rows; ++ty)
+    for (std::uint32_t tx = 0; tx < set.columns; ++tx)
+      push_beam(set, section_of(tx, ty), lists[std::size_t(ty) * set.columns + tx]);
+  return set;
 }
 
 }  // namespace rtcl::beam

@@ -1,27 +1,38 @@
-// The screen's viewing beam split into tile beams (prisms over tile x tile
-// pixel squares) with their candidate polygons in walking order. Candidates
-// are culled in screen space: a polygon is a candidate of a tile when its
-// projection meets the tile's square with positive area (exact, in double;
-// not the BVH frustum test). Walking order: descending key, the largest
-// inverse depth 1/s of the polygon's part inside the tile (its nearest
-// point there), ties by polygon index.
+// Beams and their candidate polygons in walking order. The viewing beam is
+// split into tile beams (prisms over tile x tile pixel squares); a reflected
+// beam is the prism over a mirror fragment. Candidates are culled in screen
+// space: a polygon is a candidate of a beam when its projection meets the
+// beam's cross-section with positive area (exact, in double; not a BVH
+// frustum test). Walking order: descending key, the largest inverse depth
+// 1/s of the polygon's part inside the beam (its nearest point there), ties
+// by polygon index.
 #pragma once
 
 #include <cstdint>
 #include <vector>
 
 #include "rtcl/beam/beam_layouts.hpp"
+#include "rtcl/beam/polygon2d.hpp"
 #include "rtcl/beam/screen_space.hpp"
 
 namespace rtcl::beam {
 
-struct TileBeams {
-  std::uint32_t tile_px = 8, columns = 0, rows = 0;
-  std::vector<BeamTile> tiles;            // row by row; the last column and row may be narrower
-  std::vector<std::uint32_t> candidates;  // indexes into the polygon list, per tile [first, first + count)
+struct BeamSet {
+  std::vector<Beam> beams;
+  std::vector<std::uint32_t> candidates;  // indexes into the polygon list, per beam [first, first + count)
+  std::uint32_t tile_px = 8, columns = 0, rows = 0;  // of tile beams: beams[row * columns + column]
 };
 
-TileBeams tile_beams(const std::vector<ScreenPolygon>& polygons, std::uint32_t width, std::uint32_t height,
-                     std::uint32_t tile_px = 8);
+// Appends the beam over `cross_section` (convex, counter-clockwise, 3 ..
+// RTCL_BEAM_PIECE_VERTS vertices, pixels) with candidates among
+// polygons[first .. first + count). Throws Error when the cross-section has
+// too many vertices.
+void add_beam(BeamSet& set, const Convex& cross_section, const std::vector<ScreenPolygon>& polygons,
+              std::uint32_t first, std::uint32_t count);
+
+// The tile beams of a width x height screen over all polygons, row by row;
+// the last column and row may be narrower.
+BeamSet tile_beams(const std::vector<ScreenPolygon>& polygons, std::uint32_t width, std::uint32_t height,
+                   std::uint32_t tile_px = 8);
 
 }  // namespace rtcl::beam
