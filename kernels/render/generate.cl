@@ -71,16 +71,18 @@ kernel void generate_camera_rays(global Ray* rays, global PathState* paths, glob
   paths[i] = camera_path(at);
 }
 
-/* Rays of the listed image pixels pixels[first .. first+count-1] (y * width
- * + x, each listed once) for sample `sample` of `spp` (camera_ray), in list
- * order; their paths carry the image pixel index, so the framebuffer is the
- * whole image's. */
+/* Rays of slots first .. first+count-1 of a pixel list: slot k is sample
+ * k % spp of the image pixel pixels[k / spp] (y * width + x, each listed
+ * once), so all samples of all listed pixels go in one launch (camera_ray);
+ * their paths carry the slot (the shade kernel built with RTCL_PIXEL_SLOTS
+ * reads the pixel and sample back from it). */
 kernel void generate_camera_rays_at(global Ray* rays, global PathState* paths, global const DeviceCamera* camera,
-                                    global const uint* pixels, uint first, uint count, uint sample, uint spp) {
+                                    global const uint* pixels, uint first, uint count, uint spp) {
   uint i = get_global_id(0);
   if (i >= count) return;
   DeviceCamera c = *camera;
-  uint pixel = pixels[first + i];
-  rays[i] = camera_ray(&c, pixel % c.width, pixel / c.width, sample, spp);
-  paths[i] = camera_path(pixel);
+  uint slot = first + i;
+  uint pixel = pixels[slot / spp];
+  rays[i] = camera_ray(&c, pixel % c.width, pixel / c.width, slot % spp, spp);
+  paths[i] = camera_path(slot);
 }

@@ -192,7 +192,7 @@ inline float3 light_point(global const DeviceLight* l, float3 p, float u, float 
 }
 #endif
 
-/* Per queued ray i (< count) of pixel sample `sample`, with its closest hit:
+/* Per queued ray i (< count) of pixel sample `launch_sample`, with its closest hit:
  *  radiance[i]            weight * (emission + ambient) at the hit, or weight * background on a miss;
  *  shadow slots i*S + k   (S = P.shadow_slots) a shadow ray towards a light point and its unoccluded
  *                         contribution (flag 1), or flag 0; point lights take one slot, area lights
@@ -201,16 +201,21 @@ inline float3 light_point(global const DeviceLight* l, float3 p, float u, float 
  * Paths index pixels inside the rendered region x0 .. x0+rw-1 (rows from
  * y0) of an image `width` pixels wide; samples are keyed by the pixel's
  * index in the whole image, so a pixel's samples do not depend on the
- * region. */
+ * region. With RTCL_PIXEL_SLOTS, paths index slots of a pixel list instead
+ * (each sample of each listed pixel its own slot) and `launch_sample` is
+ * unused. */
 kernel void shade_hits(global const Ray* rays, global const Hit* hits, global const PathState* paths, uint count,
                        global const ShadeTriangle* triangles, global const ShadeSphere* spheres,
                        global const DeviceMaterial* materials, global const DeviceLight* lights,
                        global const ShadeParams* params, global float4* radiance, global Ray* shadow_rays,
                        global float4* shadow_weight, global uint* shadow_flags, global Ray* spawn_rays,
-                       global PathState* spawn_paths, global uint* spawn_flags, uint sample, uint x0, uint y0,
-                       uint rw, uint width
+                       global PathState* spawn_paths, global uint* spawn_flags, uint launch_sample, uint x0,
+                       uint y0, uint rw, uint width
 #ifdef RTCL_HAS_MOTION
                        , global const ShadeTriangle* triangles_close, global const ShadeSphere* spheres_close
+#endif
+#ifdef RTCL_PIXEL_SLOTS
+                       , global const uint* pixel_list
 #endif
                        ) {
   uint i = get_global_id(0);
@@ -221,7 +226,15 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
   spawn_flags[2 * i + 1] = RTCL_SLOT_EMPTY;
 
   PathState path = paths[i];
+#ifdef RTCL_PIXEL_SLOTS
+  /* A pixel list (generate_camera_rays_at): the path's pixel is a slot,
+   * sample slot % spp of the listed pixel slot / spp. */
+  const uint image_pixel = pixel_list[path.pixel / P.spp];
+  const uint sample = path.pixel % P.spp;
+#else
   const uint image_pixel = (y0 + path.pixel / rw) * width + x0 + path.pixel % rw;
+  const uint sample = launch_sample;
+#endif
   float3 w = (float3)(path.wr, path.wg, path.wb);
   Hit h = hits[i];
   if (h.prim < 0) {

@@ -120,7 +120,7 @@ cl::Event RayQueue::generate_camera_rays(const cl::Buffer& camera, std::uint32_t
 }
 
 cl::Event RayQueue::generate_camera_rays_at(const cl::Buffer& camera, const cl::Buffer& pixels, std::uint32_t first,
-                                            std::uint32_t count, std::uint32_t sample, std::uint32_t spp,
+                                            std::uint32_t count, std::uint32_t spp,
                                             const std::vector<cl::Event>& wait) {
   rays_.reserve(device_, count);
   paths_.reserve(device_, count);
@@ -132,8 +132,7 @@ cl::Event RayQueue::generate_camera_rays_at(const cl::Buffer& camera, const cl::
     generate_at_.setArg(3, pixels);
     generate_at_.setArg(4, static_cast<cl_uint>(first));
     generate_at_.setArg(5, static_cast<cl_uint>(count));
-    generate_at_.setArg(6, static_cast<cl_uint>(sample));
-    generate_at_.setArg(7, static_cast<cl_uint>(spp));
+    generate_at_.setArg(6, static_cast<cl_uint>(spp));
     return launch(device_, generate_at_, std::max<std::uint32_t>(count, 1), wait);
   });
 }

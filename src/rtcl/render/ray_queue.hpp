@@ -78,13 +78,12 @@ class RayQueue {
                                  std::uint32_t sample, std::uint32_t spp, std::uint32_t x0, std::uint32_t y0,
                                  std::uint32_t rw, std::uint32_t rh, const std::vector<cl::Event>& wait);
 
-  // Fills the queue with camera rays of the image pixels pixels[first ..
-  // first + count - 1] (a device buffer of y * width + x, each pixel listed
-  // once) for sample `sample` of `spp`, in list order; paths carry the image
-  // pixel index.
+  // Fills the queue with the camera rays of slots first .. first + count - 1
+  // of a pixel list (a device buffer of y * width + x, each pixel listed
+  // once): slot k is sample k % spp of pixel k / spp of the list; paths
+  // carry the slot.
   cl::Event generate_camera_rays_at(const cl::Buffer& camera, const cl::Buffer& pixels, std::uint32_t first,
-                                    std::uint32_t count, std::uint32_t sample, std::uint32_t spp,
-                                    const std::vector<cl::Event>& wait);
+                                    std::uint32_t count, std::uint32_t spp, const std::vector<cl::Event>& wait);
 
   // Replaces the contents with these rays and paths (same length).
   void assign(const std::vector<Ray>& rays, const std::vector<PathState>& paths);

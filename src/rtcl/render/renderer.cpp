@@ -78,6 +78,11 @@ struct Renderer::State {
   // Moving scenes: the ray-time kernels and the queue's and shadow queue's times.
   cl::Kernel queue_times, shadow_times;
   GrowingBuffer times{"ray times", sizeof(float)}, shadow_time{"shadow ray times", sizeof(float)};
+  // The shade kernel for pixel lists (RTCL_PIXEL_SLOTS), built at the first
+  // render_pixels; while `slots` is set, shade() uses it with `pixel_list`.
+  cl::Kernel shade_slots;
+  bool slots = false;
+  cl::Buffer pixel_list;
 
   // Per render.
   RenderSettings settings;
@@ -249,28 +254,56 @@ PixelSamples Renderer::render_pixels(const RenderSettings& settings, const std::
     finish_stats(start);
     return out;
   }
-  cl::Buffer list = s.device.upload(pixels.data(), pixels.size() * sizeof(std::uint32_t), "pixel list");
+  if (std::uint64_t(n) * settings.spp > 0xffffffffull)
+    throw Error("render_pixels: " + std::to_string(n) + " pixels times " + std::to_string(settings.spp) +
+                " spp must be below 2^32 samples");
+  const std::uint32_t slots = n * settings.spp;
+  if (!s.shade_slots()) {
+    std::vector<std::string> defines = s.shading.defines;
+    defines.push_back("RTCL_PIXEL_SLOTS");
+    with_cl_errors([&] { s.shade_slots = cl::Kernel(s.device.program("render/shade.cl", defines), "shade_hits"); });
+  }
+  // One framebuffer entry per slot (sample of a listed pixel).
+  s.framebuffer = s.device.allocate(std::size_t(slots) * RTCL_RADIANCE_BYTES, "framebuffer");
+  with_cl_errors([&] {
+    cl::Event cleared;
+    s.device.queue().enqueueFillBuffer(s.framebuffer, cl_float4{}, 0, std::size_t(slots) * RTCL_RADIANCE_BYTES,
+                                       wait_list(s.last), &cleared);
+    s.last = {cleared};
+  });
+  s.pixel_list = s.device.upload(pixels.data(), pixels.size() * sizeof(std::uint32_t), "pixel list");
+  s.slots = true;
   std::vector<Hit> hits;
-  for (std::uint32_t sample = 0; sample < settings.spp; ++sample)
-    for (std::uint32_t first = 0; first < n; first += settings.batch_pixels) {
-      std::uint32_t count = std::min(settings.batch_pixels, n - first);
-      s.sample = sample;
-      cl::Event e = s.queue.generate_camera_rays_at(s.camera, list, first, count, sample, settings.spp, s.last);
+  try {
+    for (std::uint32_t first = 0; first < slots; first += settings.batch_pixels) {
+      std::uint32_t count = std::min(settings.batch_pixels, slots - first);
+      cl::Event e = s.queue.generate_camera_rays_at(s.camera, s.pixel_list, first, count, settings.spp, s.last);
       s.generates.push_back(e);
       s.last = {e};
       s.stats.rays.camera += count;
-      trace_batch(count, 0.0, 1.0, {}, sample == 0 ? &hits : nullptr);
-      for (std::uint32_t i = 0; sample == 0 && i < count; ++i) {
+      trace_batch(count, 0.0, 1.0, {}, &hits);
+      for (std::uint32_t i = 0; i < count; ++i) {
+        const std::uint32_t slot = first + i;
+        if (slot % settings.spp != 0) continue;  // sample 0 gives the first hit
         const Hit& h = hits[i];
         const bool hit = h.prim >= 0;
-        out.depth[first + i] = hit ? h.t : INFINITY;
-        out.object[first + i] = hit ? static_cast<std::int32_t>(s.flat.material.at(std::size_t(h.prim))) : -1;
+        out.depth[slot / settings.spp] = hit ? h.t : INFINITY;
+        out.object[slot / settings.spp] = hit ? static_cast<std::int32_t>(s.flat.material.at(std::size_t(h.prim))) : -1;
       }
     }
-  std::vector<cl_float4> sums = read_framebuffer(image_pixels);
+  } catch (...) {
+    s.slots = false;
+    throw;
+  }
+  s.slots = false;
+  std::vector<cl_float4> sums = read_framebuffer(slots);
   const float inv = 1.0f / static_cast<float>(settings.spp);
   for (std::uint32_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) out.rgb[std::size_t(i) * 3 + c] = sums[pixels[i]].s[c] * inv;
+    for (int c = 0; c < 3; ++c) {
+      float sum = 0.0f;  // in sample order
+      for (std::uint32_t k = 0; k < settings.spp; ++k) sum += sums[std::size_t(i) * settings.spp + k].s[c];
+      out.rgb[std::size_t(i) * 3 + c] = sum * inv;
+    }
   finish_stats(start);
   return out;
 }
@@ -382,7 +415,7 @@ void Renderer::shade() {
   s.shadow_slots.count = n * s.slots_per_ray;
   s.spawn.reserve(s.device, 2 * n);
   with_cl_errors([&] {
-    cl::Kernel& k = s.shade;
+    cl::Kernel& k = s.slots ? s.shade_slots : s.shade;
     cl_uint a = 0;
     k.setArg(a++, s.queue.rays());
     k.setArg(a++, s.hits.buffer());
@@ -409,6 +442,7 @@ void Renderer::shade() {
       k.setArg(a++, s.shading.triangles_close);
       k.setArg(a++, s.shading.spheres_close);
     }
+    if (s.slots) k.setArg(a++, s.pixel_list);
     cl::Event e = launch(s.device, k, n, s.last);
     s.shades.push_back(e);
     s.last = {e};
@@ -472,6 +506,8 @@ void Renderer::queue_times() {
     k.setArg(a++, static_cast<cl_uint>(s.region.width));
     k.setArg(a++, static_cast<cl_uint>(s.settings.width));
     k.setArg(a++, s.times.buffer());
+    k.setArg(a++, static_cast<cl_uint>(s.slots));
+    k.setArg(a++, s.slots ? s.pixel_list : s.times.buffer());  // unread unless listed
     s.last = {launch(s.device, k, n, s.last)};
   });
 }

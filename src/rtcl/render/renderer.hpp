@@ -130,13 +130,16 @@ class Renderer {
   Image render(const RenderSettings& settings, const ImageRegion& region, const RenderProgress& progress = {});
 
   // Only the listed pixels of the image (y * width + x, each at most once,
-  // in any order): camera rays for all of them in the same launches
-  // (batches of settings.batch_pixels, one per pixel sample), traced,
-  // shaded and accumulated like render(settings)'s, so each pixel's colour
-  // is that image's pixel bit for bit. Its first hit (depth, material) is
-  // read back from sample 0's camera rays. For selective tracing
-  // (selective.hpp). Throws Error naming a pixel outside the image or
-  // listed twice.
+  // in any order): every sample of every listed pixel in the same launches
+  // (batches of settings.batch_pixels samples), with the camera, light,
+  // lens and glossy samples of render(settings), traced, shaded and
+  // accumulated the same way. With 1 spp each pixel is that image's pixel
+  // bit for bit; with more, the same up to the order in which a pixel's
+  // float radiance is summed (here per sample, then over the samples in
+  // sample order; there per generation into one sum). Its first hit
+  // (depth, material) is that of sample 0's camera ray. For selective
+  // tracing (selective.hpp). Throws Error naming a pixel outside the image
+  // or listed twice.
   PixelSamples render_pixels(const RenderSettings& settings, const std::vector<std::uint32_t>& pixels);
 
   // The ray tree of one ray, for inspection and tests: generation 0 is
