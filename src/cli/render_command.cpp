@@ -18,8 +18,8 @@
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/render/sampling_options.hpp"
-#include "rtcl/scene/default_scene.hpp"
 #include "rtcl/scene/scene_file.hpp"
+#include "rtcl/scene/showcase_scene.hpp"
 
 namespace rtcl::cli {
 
@@ -80,8 +80,14 @@ void run(const RenderOptions& o) {
 
 }  // namespace
 
+Scene read_render_scene(const RenderOptions& o) {
+  if (!o.scene.empty() && !o.builtin.empty())
+    throw Error("--builtin " + o.builtin + ": give a scene file or a built-in scene, not both (scene file " + o.scene + ")");
+  return o.scene.empty() ? builtin_scene(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
+}
+
 Scene load_render_scene(const RenderOptions& o) {
-  Scene scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
+  Scene scene = read_render_scene(o);
   for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   return scene;
 }
@@ -133,7 +139,11 @@ void add_render_command(CLI::App& app) {
       "render", "Whitted and distributed ray tracing (reflection, refraction, hard and soft shadows, "
                 "anti-aliasing, depth of field, glossy reflection) of a scene file, or of the built-in default scene "
                 "when none is given");
-  cmd->add_option("scene", o->scene, "Scene file (JSON, see README); none: the built-in default scene");
+  cmd->add_option("scene", o->scene, "Scene file (JSON, see README); none: a built-in scene (--builtin)");
+  cmd->add_option("--builtin", o->builtin,
+                  "Built-in scene when no scene file is given: default (Whitted: mirror, glass, hard shadows) | "
+                  "showcase (area light, glossy, glass, depth of field, motion blur)")
+      ->check(CLI::IsMember({"default", "showcase"}));
   cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
                                             ".exr: linear float)")
       ->capture_default_str();

@@ -53,6 +53,10 @@ nlohmann::json plan_header(const RenderPlan& plan, const RenderOptions& o) {
           {"depth", s.max_depth},
           {"min_weight", s.min_weight},
           {"batch", s.batch_pixels},
+          {"sampler", static_cast<std::uint32_t>(s.sampler)},
+          {"seed", s.seed},
+          {"filter", static_cast<std::uint32_t>(s.filter)},
+          {"light_samples", s.light_samples},
           {"precision", std::string(precision_name(plan.config.precision))},
           {"accel", plan.accel},
           {"tile", o.tile},
@@ -67,6 +71,10 @@ RenderPlan plan_of(const nlohmann::json& h) {
   plan.settings.max_depth = h["depth"];
   plan.settings.min_weight = h["min_weight"].get<float>();
   plan.settings.batch_pixels = h["batch"];
+  plan.settings.sampler = static_cast<Sampler>(h["sampler"].get<std::uint32_t>());
+  plan.settings.seed = h["seed"];
+  plan.settings.filter = static_cast<Filter>(h["filter"].get<std::uint32_t>());
+  plan.settings.light_samples = h["light_samples"];
   plan.config.precision = parse_precision(h["precision"].get<std::string>());
   plan.accel = h["accel"];
   return plan;
@@ -175,7 +183,7 @@ void run(MpiWorld& world, const RenderOptions& o) {
     }
     if (!broadcast && !root) {
       Clock::time_point start = Clock::now();
-      scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
+      scene = read_render_scene(o);
       scene_ms = ms_since(start);
     }
     report["scene_ms"] = broadcast ? broadcast_ms : scene_ms;
