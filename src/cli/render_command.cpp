@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "distributed.hpp"
 #include "render_options.hpp"
+#include "render_units.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
@@ -66,16 +67,26 @@ void run(const RenderOptions& o) {
   }
   if (!o.accel.empty()) parse_accel_spec(o.accel);  // before the scene is loaded
   Scene scene = load_render_scene(o);
-  check_image_path(o.output);  // before the long work
   RenderPlan plan = plan_render(o, scene);
+  RenderUnits units = plan_units(o, scene, plan.settings.spp);  // checks the output paths before the long work
   Device device = Device::open(o.device);
   require_precision(device.info(), plan.config.precision);
-  Renderer renderer(device, scene, plan.accel, plan.config);
-  ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
-  Image image = renderer.render(plan.settings, [&](double f) { bar.update(f); });
-  bar.finish();
-  write_image(o.output, image);
-  print_render_summary(o, plan, device.info().name, renderer.stats(), renderer.defines());
+  std::unique_ptr<Renderer> renderer;
+  for (const RenderUnit& unit : units.units) {
+    // A frame is a scene of its own (its shutter interval); a sweep's
+    // images share the renderer.
+    if (!renderer || units.kind == UnitKind::frames)
+      renderer = std::make_unique<Renderer>(device, unit_scene(scene, units, unit), plan.accel, plan.config);
+    RenderPlan unit_plan = plan;
+    unit_plan.settings.spp = unit.spp;
+    ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
+    Image image = renderer->render(unit_plan.settings, [&](double f) { bar.update(f); });
+    bar.finish();
+    write_image(unit.output, image);
+    RenderOptions unit_options = o;
+    unit_options.output = unit.output;
+    print_render_summary(unit_options, unit_plan, device.info().name, renderer->stats(), renderer->defines());
+  }
 }
 
 }  // namespace
@@ -191,6 +202,13 @@ void add_render_command(CLI::App& app) {
                   "Drop secondary rays whose path weight is below this (speed/accuracy; 0 keeps all)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--frames", o->frames,
+                  "Animation: render frames A:B of a scene with moving objects; frame f's shutter is the camera's "
+                  "moved by f * --frame-time; the output needs a %d or %04d field for the frame number");
+  cmd->add_option("--frame-time", o->frame_time,
+                  "With --frames: keyframe time from one frame to the next (default: the shutter's length)");
+  cmd->add_option("--spp-sweep", o->spp_sweep,
+                  "One image per samples-per-pixel value, e.g. 1,4,16; the output needs a %d field for the value");
   cmd->add_option("--batch", o->batch, "Camera rays per wavefront (device memory vs parallelism)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 26));

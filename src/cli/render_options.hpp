@@ -25,6 +25,11 @@ struct RenderOptions {
   std::uint32_t batch = 1u << 17;
   std::string sampler = "stratified", filter = "box";
   std::uint32_t seed = 0, light_samples = 1;
+  // Several images (render_units.hpp): an animation's frames "A:B" with
+  // `frame_time` keyframe time between frames (0: the shutter's length), or
+  // samples-per-pixel values "1,4,16"; `output` then holds a %d field.
+  std::string frames, spp_sweep;
+  double frame_time = 0.0;
   bool quiet = false;
   bool verbose = false;
   // Under mpirun only: tile side in pixels (a multiple of 8), the order
