@@ -148,8 +148,8 @@ void add_render_command(CLI::App& app) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand(
       "render", "Whitted and distributed ray tracing (reflection, refraction, hard and soft shadows, "
-                "anti-aliasing, depth of field, glossy reflection) of a scene file, or of the built-in default scene "
-                "when none is given");
+                "anti-aliasing, depth of field, glossy reflection, motion blur) of a scene file, or of a built-in "
+                "scene when none is given; animations (--frames) and sample sweeps (--spp-sweep)");
   cmd->add_option("scene", o->scene, "Scene file (JSON, see README); none: a built-in scene (--builtin)");
   cmd->add_option("--builtin", o->builtin,
                   "Built-in scene when no scene file is given: default (Whitted: mirror, glass, hard shadows) | "
