@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "distributed.hpp"
 #include "render_options.hpp"
+#include "render_units.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/beam/beam_renderer.hpp"
 #include "rtcl/cl/device.hpp"
@@ -24,6 +25,7 @@
 #include "rtcl/render/wavelet.hpp"
 #include "rtcl/scene/default_scene.hpp"
 #include "rtcl/scene/scene_file.hpp"
+#include "rtcl/scene/showcase_scene.hpp"
 
 namespace rtcl::cli {
 
@@ -140,26 +142,42 @@ void run(const RenderOptions& o) {
   }
   if (!o.accel.empty()) parse_accel_spec(o.accel);  // before the scene is loaded
   Scene scene = load_render_scene(o);
-  check_image_path(o.output);  // before the long work
   RenderPlan plan = plan_render(o, scene);
+  RenderUnits units = plan_units(o, scene, plan.settings.spp);  // checks the output paths before the long work
   Device device = Device::open(o.device);
   require_precision(device.info(), plan.config.precision);
-  Renderer renderer(device, scene, plan.accel, plan.config);
-  if (o.method != "ray") {
-    write_image(o.output, render_sparse(o, plan, renderer));
-    return;
+  std::unique_ptr<Renderer> renderer;
+  for (const RenderUnit& unit : units.units) {
+    // A frame is a scene of its own (its shutter interval); a sweep's
+    // images share the renderer.
+    if (!renderer || units.kind == UnitKind::frames)
+      renderer = std::make_unique<Renderer>(device, unit_scene(scene, units, unit), plan.accel, plan.config);
+    RenderPlan unit_plan = plan;
+    unit_plan.settings.spp = unit.spp;
+    if (o.method != "ray") {
+      write_image(unit.output, render_sparse(o, unit_plan, *renderer));
+      continue;
+    }
+    ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
+    Image image = renderer->render(unit_plan.settings, [&](double f) { bar.update(f); });
+    bar.finish();
+    write_image(unit.output, image);
+    RenderOptions unit_options = o;
+    unit_options.output = unit.output;
+    print_render_summary(unit_options, unit_plan, device.info().name, renderer->stats(), renderer->defines());
   }
-  ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
-  Image image = renderer.render(plan.settings, [&](double f) { bar.update(f); });
-  bar.finish();
-  write_image(o.output, image);
-  print_render_summary(o, plan, device.info().name, renderer.stats(), renderer.defines());
 }
 
 }  // namespace
 
+Scene read_render_scene(const RenderOptions& o) {
+  if (!o.scene.empty() && !o.builtin.empty())
+    throw Error("--builtin " + o.builtin + ": give a scene file or a built-in scene, not both (scene file " + o.scene + ")");
+  return o.scene.empty() ? builtin_scene(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
+}
+
 Scene load_render_scene(const RenderOptions& o) {
-  Scene scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
+  Scene scene = read_render_scene(o);
   for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   return scene;
 }
@@ -209,9 +227,13 @@ void add_render_command(CLI::App& app) {
   auto o = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand(
       "render", "Whitted and distributed ray tracing (reflection, refraction, hard and soft shadows, "
-                "anti-aliasing, depth of field, glossy reflection) of a scene file, or of the built-in default scene "
-                "when none is given");
-  cmd->add_option("scene", o->scene, "Scene file (JSON, see README); none: the built-in default scene");
+                "anti-aliasing, depth of field, glossy reflection, motion blur) of a scene file, or of a built-in "
+                "scene when none is given; animations (--frames) and sample sweeps (--spp-sweep)");
+  cmd->add_option("scene", o->scene, "Scene file (JSON, see README); none: a built-in scene (--builtin)");
+  cmd->add_option("--builtin", o->builtin,
+                  "Built-in scene when no scene file is given: default (Whitted: mirror, glass, hard shadows) | "
+                  "showcase (area light, glossy, glass, depth of field, motion blur)")
+      ->check(CLI::IsMember({"default", "showcase"}));
   cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
                                             ".exr: linear float)")
       ->capture_default_str();
@@ -286,6 +308,13 @@ void add_render_command(CLI::App& app) {
                   "(speed/accuracy)")
       ->capture_default_str()
       ->check(real_in("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; }));
+  cmd->add_option("--frames", o->frames,
+                  "Animation: render frames A:B of a scene with moving objects; frame f's shutter is the camera's "
+                  "moved by f * --frame-time; the output needs a %d or %04d field for the frame number");
+  cmd->add_option("--frame-time", o->frame_time,
+                  "With --frames: keyframe time from one frame to the next (default: the shutter's length)");
+  cmd->add_option("--spp-sweep", o->spp_sweep,
+                  "One image per samples-per-pixel value, e.g. 1,4,16; the output needs a %d field for the value");
   cmd->add_option("--batch", o->batch, "Camera rays per wavefront (device memory vs parallelism)")
       ->capture_default_str()
       ->check(CLI::Range(1u, 1u << 26));

@@ -14,6 +14,7 @@ namespace rtcl::cli {
 
 struct RenderOptions {
   std::string scene;
+  std::string builtin;  // a built-in scene's name (rtcl/scene/showcase_scene.hpp) when no scene file is given
   std::string output = "render.png";
   std::string accel;
   std::string precision;  // "": the scene file's, else robust
@@ -35,6 +36,11 @@ struct RenderOptions {
   std::string beam_order = "exact";
   std::uint32_t selective_block = 8;
   float selective_threshold = 0.05f, selective_depth = 0.1f, wavelet_budget = 0.25f;
+  // Several images (render_units.hpp): an animation's frames "A:B" with
+  // `frame_time` keyframe time between frames (0: the shutter's length), or
+  // samples-per-pixel values "1,4,16"; `output` then holds a %d field.
+  std::string frames, spp_sweep;
+  double frame_time = 0.0;
   bool quiet = false;
   bool verbose = false;
   // Under mpirun only: tile side in pixels (a multiple of 8), the order
@@ -55,9 +61,12 @@ struct RenderPlan {
 };
 RenderPlan plan_render(const RenderOptions& o, const Scene& scene);
 
-// The scene the options name (the built-in default scene when none), its
-// notes printed on stderr.
+// The scene the options name: the scene file, else the --builtin scene
+// (default: "default"), its notes printed on stderr. Throws Error for a
+// file and --builtin both, or an unknown built-in name.
 Scene load_render_scene(const RenderOptions& o);
+// The same without printing the notes (every rank but the first).
+Scene read_render_scene(const RenderOptions& o);
 
 // The summary line(s) on stdout: rays, time and rate; with --verbose the
 // stage times. `devices`: the device name, or how many ranks and devices.

@@ -19,6 +19,7 @@
 #include "mpi/job_farm.hpp"
 #include "mpi/mpi_world.hpp"
 #include "mpi/rank_device.hpp"
+#include "render_units.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/tiles.hpp"
@@ -43,20 +44,39 @@ struct StoppedByRoot : std::exception {
   const char* what() const noexcept override { return "stopped: rank 0 failed before rendering"; }
 };
 
-// What rank 0 decided, sent to every rank: the plan and the tiles.
-nlohmann::json plan_header(const RenderPlan& plan, const RenderOptions& o) {
+// What rank 0 decided, sent to every rank: the plan, the tiles and the
+// images (units) to render.
+nlohmann::json plan_header(const RenderPlan& plan, const RenderOptions& o, const RenderUnits& units) {
   const RenderSettings& s = plan.settings;
+  nlohmann::json list = nlohmann::json::array();
+  for (const RenderUnit& u : units.units) list.push_back({{"output", u.output}, {"frame", u.frame}, {"spp", u.spp}});
   return {{"ok", true},
+          {"unit_kind", static_cast<int>(units.kind)},
+          {"frame_time", units.frame_time},
+          {"units", list},
           {"width", s.width},
           {"height", s.height},
           {"spp", s.spp},
           {"depth", s.max_depth},
           {"min_weight", s.min_weight},
           {"batch", s.batch_pixels},
+          {"sampler", static_cast<std::uint32_t>(s.sampler)},
+          {"seed", s.seed},
+          {"filter", static_cast<std::uint32_t>(s.filter)},
+          {"light_samples", s.light_samples},
           {"precision", std::string(precision_name(plan.config.precision))},
           {"accel", plan.accel},
           {"tile", o.tile},
           {"tile_order", o.tile_order}};
+}
+
+RenderUnits units_of(const nlohmann::json& h) {
+  RenderUnits units;
+  units.kind = static_cast<UnitKind>(h["unit_kind"].get<int>());
+  units.frame_time = h["frame_time"];
+  for (const nlohmann::json& u : h["units"])
+    units.units.push_back({u["output"].get<std::string>(), u["frame"].get<std::int64_t>(), u["spp"].get<std::uint32_t>()});
+  return units;
 }
 
 RenderPlan plan_of(const nlohmann::json& h) {
@@ -67,6 +87,10 @@ RenderPlan plan_of(const nlohmann::json& h) {
   plan.settings.max_depth = h["depth"];
   plan.settings.min_weight = h["min_weight"].get<float>();
   plan.settings.batch_pixels = h["batch"];
+  plan.settings.sampler = static_cast<Sampler>(h["sampler"].get<std::uint32_t>());
+  plan.settings.seed = h["seed"];
+  plan.settings.filter = static_cast<Filter>(h["filter"].get<std::uint32_t>());
+  plan.settings.light_samples = h["light_samples"];
   plan.config.precision = parse_precision(h["precision"].get<std::string>());
   plan.accel = h["accel"];
   return plan;
@@ -111,6 +135,7 @@ void add(RenderStats& sum, const TileStats& t) {
 struct RankRenderer {
   std::unique_ptr<Device> device;
   std::unique_ptr<Renderer> renderer;
+  std::size_t unit = 0;  // the unit (animation frame) `renderer` renders
   std::size_t tiles_run = 0;
 };
 
@@ -122,6 +147,7 @@ void run(MpiWorld& world, const RenderOptions& o) {
   // --- rank 0 decides; the decision (or its failure) goes to every rank ---
   Scene scene;
   RenderPlan plan;
+  RenderUnits units;
   std::string header_text;
   double scene_ms = 0.0;
   if (root) {
@@ -131,10 +157,10 @@ void run(MpiWorld& world, const RenderOptions& o) {
       Clock::time_point start = Clock::now();
       scene = load_render_scene(o);
       scene_ms = ms_since(start);
-      check_image_path(o.output);
       plan = plan_render(o, scene);
+      units = plan_units(o, scene, plan.settings.spp);  // checks the output paths
       image_tiles(plan.settings.width, plan.settings.height, o.tile, parse_tile_order(o.tile_order));  // checks
-      header = plan_header(plan, o);
+      header = plan_header(plan, o, units);
     } catch (const std::exception& e) {
       header = {{"ok", false}};
       header_text = header.dump();
@@ -148,7 +174,10 @@ void run(MpiWorld& world, const RenderOptions& o) {
   broadcast_bytes(header_bytes, 0);
   nlohmann::json header = nlohmann::json::parse(as_text(header_bytes));
   if (!header["ok"].get<bool>()) throw StoppedByRoot();
-  if (!root) plan = plan_of(header);
+  if (!root) {
+    plan = plan_of(header);
+    units = units_of(header);
+  }
   const std::uint32_t tile = header["tile"];
   std::vector<ImageRegion> tiles = image_tiles(plan.settings.width, plan.settings.height, tile,
                                                parse_tile_order(header["tile_order"].get<std::string>()));
@@ -175,7 +204,7 @@ void run(MpiWorld& world, const RenderOptions& o) {
     }
     if (!broadcast && !root) {
       Clock::time_point start = Clock::now();
-      scene = o.scene.empty() ? default_scene() : load_scene(o.scene);
+      scene = read_render_scene(o);
       scene_ms = ms_since(start);
     }
     report["scene_ms"] = broadcast ? broadcast_ms : scene_ms;
@@ -183,7 +212,8 @@ void run(MpiWorld& world, const RenderOptions& o) {
     report["device"] = mine.device->info().name;
     require_precision(mine.device->info(), plan.config.precision);
     Clock::time_point start = Clock::now();
-    mine.renderer = std::make_unique<Renderer>(*mine.device, scene, plan.accel, plan.config);
+    mine.renderer = std::make_unique<Renderer>(*mine.device, unit_scene(scene, units, units.units.front()),
+                                               plan.accel, plan.config);
     // Warm-up: PoCL generates a kernel's code at its first launch; one
     // tile rendered and dropped keeps that out of the tiles' times.
     mine.renderer->render(plan.settings, tiles.front());
@@ -191,10 +221,21 @@ void run(MpiWorld& world, const RenderOptions& o) {
     report["build_ms"] = mine.renderer->accel().stats().build_ms;
     return report;
   };
+  // Job j is tile j % tiles of unit j / tiles: the units' tiles in unit
+  // order, so a rank mostly stays on one frame's renderer.
   JobRun render_tile = [&](std::size_t job) -> std::vector<std::byte> {
     bool faulty = fault.rank == world.rank && mine.tiles_run++ == 0;
     if (faulty && fault.kind == FaultKind::kill) ::raise(SIGKILL);
-    Image part = mine.renderer->render(plan.settings, tiles.at(job));
+    const std::size_t u = job / tiles.size();
+    if (units.kind == UnitKind::frames && u != mine.unit) {
+      mine.renderer.reset();
+      mine.renderer = std::make_unique<Renderer>(*mine.device, unit_scene(scene, units, units.units.at(u)), plan.accel,
+                                                 plan.config);
+      mine.unit = u;
+    }
+    RenderSettings settings = plan.settings;
+    settings.spp = units.units.at(u).spp;
+    Image part = mine.renderer->render(settings, tiles.at(job % tiles.size()));
     if (faulty && fault.kind == FaultKind::error)
       throw Error("injected fault (RTCL_MPI_FAULT=error:" + std::to_string(world.rank) + ") after its first tile");
     return tile_bytes(part, mine.renderer->stats());
@@ -204,37 +245,50 @@ void run(MpiWorld& world, const RenderOptions& o) {
     return;
   }
 
-  Image image{plan.settings.width, plan.settings.height,
-              std::vector<float>(std::size_t(plan.settings.width) * plan.settings.height * 3, 0.0f)};
+  // Each unit's image, written as soon as its last tile is in.
+  std::vector<Image> images(units.units.size());
+  std::vector<std::size_t> missing(units.units.size(), tiles.size());
   RenderStats total;
   std::vector<double> render_ms(world.size, 0.0);  // the ranks' own time in Renderer::render
   std::vector<double> slowest_ms(world.size, 0.0);  // their slowest tile
-  std::vector<std::size_t> order(tiles.size());
+  std::vector<std::size_t> order(tiles.size() * units.units.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
   FarmTimes times;
   std::vector<RankOutcome> outcomes = serve_jobs(
       world, order, setup, render_tile,
       [&](int rank, std::size_t job, std::span<const std::byte> bytes) {
-        const ImageRegion& r = tiles.at(job);
+        const std::size_t u = job / tiles.size();
+        const ImageRegion& r = tiles.at(job % tiles.size());
         TileStats t;
         if (bytes.size() != sizeof t + std::size_t(r.width) * r.height * 3 * sizeof(float))
           throw Error("MPI: tile " + std::to_string(job) + " came back with " + std::to_string(bytes.size()) + " bytes");
         std::memcpy(&t, bytes.data(), sizeof t);
         Image part{r.width, r.height, std::vector<float>(std::size_t(r.width) * r.height * 3)};
         std::memcpy(part.rgb.data(), bytes.data() + sizeof t, part.rgb.size() * sizeof(float));
+        Image& image = images.at(u);
+        if (image.rgb.empty())
+          image = Image{plan.settings.width, plan.settings.height,
+                        std::vector<float>(std::size_t(plan.settings.width) * plan.settings.height * 3, 0.0f)};
         paste(image, r, part);
+        if (--missing[u] == 0) {
+          write_image(units.units[u].output, image);
+          image = Image{};
+        }
         add(total, t);
         render_ms[rank] += t.render_ms;
         slowest_ms[rank] = std::max(slowest_ms[rank], t.render_ms);
       },
       &times);
   total.render_ms = times.span_ms;
-  write_image(o.output, image);
+  for (std::size_t u = 0; u < units.units.size(); ++u)
+    if (missing[u] != 0) throw Error("internal: " + units.units[u].output + " misses " + std::to_string(missing[u]) + " tiles");
 
   std::size_t failed = 0;
   for (const RankOutcome& r : outcomes) failed += !r.failure.empty();
   std::string devices = std::to_string(world.size) + " MPI ranks, " + std::to_string(tiles.size()) + " tiles of " +
-                        std::to_string(tile) + " px" + (failed ? ", " + std::to_string(failed) + " failed" : "");
+                        std::to_string(tile) + " px" +
+                        (units.units.size() > 1 ? " in each of " + std::to_string(units.units.size()) + " images" : "") +
+                        (failed ? ", " + std::to_string(failed) + " failed" : "");
   print_render_summary(o, plan, devices, total,
                        mine.renderer ? mine.renderer->defines() : std::vector<std::string>{});
   if (broadcast)

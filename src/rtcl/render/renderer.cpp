@@ -351,7 +351,8 @@ void Renderer::finish_stats(std::chrono::steady_clock::time_point start) {
   s.stats.queue_bytes = s.queue.bytes() + s.next.bytes() + s.shadows.bytes() + s.hits.bytes() +
                         s.radiance.bytes() + s.spawn.rays.bytes() + s.spawn.paths.bytes() + s.spawn.flags.bytes() +
                         s.shadow_slots.rays.bytes() + s.shadow_slots.weights.bytes() +
-                        s.shadow_slots.flags.bytes() + s.shadow_slots.index.bytes();
+                        s.shadow_slots.flags.bytes() + s.shadow_slots.index.bytes() + s.times.bytes() +
+                        s.shadow_time.bytes();
   s.stats.render_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
