@@ -69,8 +69,8 @@ Scene cornell_soft() {
   sm.triangles = std::move(mesh.geometry.triangles);
   sm.materials = std::move(mesh.triangle_material);
   scene.meshes.push_back(std::move(sm));
-  scene.spheres.push_back(SceneSphere{{0.32, 0.8, 0.37}, 0.2, base});
-  scene.spheres.push_back(SceneSphere{{-0.45, 0.25, 0.55}, 0.25, base + 1});
+  scene.spheres.push_back(SceneSphere::still({0.32, 0.8, 0.37}, 0.2, base));
+  scene.spheres.push_back(SceneSphere::still({-0.45, 0.25, 0.55}, 0.25, base + 1));
   return scene;
 }
 

@@ -279,7 +279,7 @@ TEST(Render, NoShadowAcneAtGrazingAnglesAtAnyScale) {
   base.materials = {white};
   base.lights.push_back(PointLight{{1.0f, 4.0f, -1.0f}, glm::vec3(1.0f), 1.0f});
   base.meshes.push_back(box_mesh({-30.0f, -1.0f, -30.0f}, {30.0f, 0.0f, 30.0f}, 0));
-  base.spheres.push_back(SceneSphere{{0.0, 0.5, 0.0}, 0.5, 0});
+  base.spheres.push_back(SceneSphere::still({0.0, 0.5, 0.0}, 0.5, 0));
   for (Precision level : {Precision::robust, Precision::exact})
     for (const ScaleCase& c : kScaleCases)
       expect_scaled_scene_matches_reference(base, {c.what, c.transform, c.edge_radius, 4096, c.max_smooth_error}, level);

@@ -101,8 +101,8 @@ Scene default_scene() {
   s.materials = materials();
   s.meshes.push_back(room());
   s.meshes.push_back(glass_block());
-  s.spheres.push_back(SceneSphere{{-0.45, 0.42, -0.3}, 0.42, mirror});
-  s.spheres.push_back(SceneSphere{{0.3, 0.3, 0.45}, 0.3, glass});
+  s.spheres.push_back(SceneSphere::still({-0.45, 0.42, -0.3}, 0.42, mirror));
+  s.spheres.push_back(SceneSphere::still({0.3, 0.3, 0.45}, 0.3, glass));
   return s;
 }
 

@@ -105,6 +105,15 @@ struct SceneSphere {
   glm::dvec3 end_center{0.0};
   double end_radius = 1.0;
   std::string motion_key;  // as SceneMesh::motion_key
+
+  // A sphere that does not move.
+  static SceneSphere still(glm::dvec3 center, double radius, std::uint32_t material) {
+    SceneSphere s;
+    s.center = center;
+    s.radius = radius;
+    s.material = material;
+    return s;
+  }
 };
 
 struct Scene {

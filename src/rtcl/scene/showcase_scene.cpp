@@ -48,13 +48,13 @@ Scene showcase_scene() {
   red.diffuse = red.ambient = {0.7f, 0.1f, 0.08f};
   red.specular = glm::vec3(0.3f);
   red.shininess = 60.0f;
-  s.spheres.push_back(SceneSphere{{-0.32, 0.55, 2.3}, 0.12, add_material(s, red)});
+  s.spheres.push_back(SceneSphere::still({-0.32, 0.55, 2.3}, 0.12, add_material(s, red)));
   // Motion blur: a yellow ball crossing the room at mid-height.
   Material yellow;
   yellow.name = "moving yellow";
   yellow.diffuse = yellow.ambient = {0.9f, 0.6f, 0.02f};
   yellow.specular = glm::vec3(0.2f);
-  SceneSphere ball{{-0.55, 1.25, 0.2}, 0.15, add_material(s, yellow)};
+  SceneSphere ball = SceneSphere::still({-0.55, 1.25, 0.2}, 0.15, add_material(s, yellow));
   ball.moving = true;
   ball.end_center = ball.center + glm::dvec3(0.4, 0.1, 0.0);
   ball.end_radius = ball.radius;
