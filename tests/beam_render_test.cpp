@@ -3,6 +3,8 @@
 // beams, the image against the ray tracer at 64 spp, and the refusals.
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -18,6 +20,7 @@
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/scene/scene_file.hpp"
 #include "support/cli_run.hpp"
+#include "support/error_of.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference_renderer.hpp"
 
@@ -136,9 +139,21 @@ TEST(BeamRender, CommandLine) {
   EXPECT_NE(ok.out.find("reflection beams to depth 5, no refraction beams"), std::string::npos) << ok.out;
   expect_failure(run_cli(dir, {"render", scenes + "cornell.json", "--method", "beam", "-o", "s.png", "--width", "16"}),
                  "--method beam traces polygons only, and the scene has 2 sphere(s)", dir, "s.png");
+  expect_failure(run_cli(dir, {"render", scenes + "cornell_beam.json", "--method", "beam", "--frames", "0:1", "-o",
+                                "f%d.png", "--width", "16"}),
+                 "--frames: not with --method beam", dir, "f0.png");
   expect_usage_error(run_cli(dir, {"render", "--method", "cone", "-o", "x.png"}), "--method");
   expect_usage_error(run_cli(dir, {"render", "--method", "beam", "--beam-order", "random", "-o", "x.png"}),
                      "--beam-order");
+}
+
+TEST(BeamRender, MovingObjectsAreRefused) {
+  Scene scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_beam.json");
+  ASSERT_FALSE(scene.meshes.empty());
+  scene.meshes[0].end_transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.1, 0.0, 0.0));
+  scene.meshes[0].motion_key = "moving.json: objects[0].motion";
+  EXPECT_NE(error_of([&] { beam::check_beam_scene(scene); }).find("moving.json: objects[0].motion: a moving object"),
+            std::string::npos);
 }
 
 }  // namespace

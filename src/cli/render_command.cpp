@@ -133,6 +133,9 @@ void run(const RenderOptions& o) {
   if (launcher_world_size() && o.method != "ray")
     throw Error("--method " + o.method + ": not under mpirun (only --method ray renders with ranks)");
   if (o.method == "beam") {
+    if (!o.frames.empty() || !o.spp_sweep.empty())
+      throw Error(std::string(o.frames.empty() ? "--spp-sweep" : "--frames") +
+                  ": not with --method beam (it renders one static image)");
     if (!o.accel.empty()) parse_accel_spec(o.accel);
     return run_beam(o);
   }

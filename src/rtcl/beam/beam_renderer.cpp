@@ -180,6 +180,9 @@ void check_beam_scene(const Scene& scene) {
     if (scene.lights[i].area())
       throw Error(scene.source + ": light " + std::to_string(i) +
                   " is an area light; --method beam shades with point lights only (use --method ray)");
+  for (const SceneMesh& mesh : scene.meshes)
+    if (mesh.end_transform)
+      throw Error(mesh.motion_key + ": a moving object; --method beam traces a static scene (use --method ray)");
   for (const Material& m : scene.materials)
     if (m.transmissive() || m.glossy())
       throw Error(scene.source + ": material '" + m.name + "' is " + (m.transmissive() ? "transmissive" : "glossy") +
