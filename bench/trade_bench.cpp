@@ -9,7 +9,9 @@
 //
 // Scenes: scenes/cornell_soft.json (the lamp's emissive triangles as area
 // lights, a glossy and a glass sphere, a thin lens) and scenes/sibenik.json
-// with its point light made a sphere light of radius 1 (soft shadows).
+// with its point light made a sphere light of radius 1 (soft shadows) and a
+// red ball of radius 0.8 moving 2 units across the nave over the shutter
+// (motion blur).
 // Size $RTCL_BENCH_TRADE_RES squared (default 128); Sobol, depth 5, 1 light
 // sample, box filter, min weight 0.001, block 8 unless named. Each iteration renders another
 // seed; counters: rmse and ssim (root mean square and mean over the
@@ -52,6 +54,17 @@ Scene trade_scene(const std::string& name) {
   Scene scene = load_scene(repo_scene("sibenik.json"));
   scene.lights.at(0).shape = LightShape::sphere;
   scene.lights.at(0).radius = 1.0f;
+  // A ball crossing the nave during the shutter: motion blur.
+  Material red;
+  red.name = "moving ball";
+  red.diffuse = red.ambient = {0.8f, 0.15f, 0.1f};
+  scene.materials.push_back(red);
+  SceneSphere ball = SceneSphere::still({-9.0, -10.0, -1.0}, 0.8, static_cast<std::uint32_t>(scene.materials.size() - 1));
+  ball.moving = true;
+  ball.end_center = ball.center + glm::dvec3(0.0, 0.0, 2.0);
+  ball.end_radius = ball.radius;
+  ball.motion_key = "trade_bench: moving ball";
+  scene.spheres.push_back(ball);
   return scene;
 }
 
