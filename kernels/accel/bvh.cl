@@ -31,6 +31,7 @@
  * that kind; each kind's record array is an argument only then, and
  * without any of them the kernel has no filter code and no extra
  * arguments. */
+#include "shared/bvh8_stack.h"
 #include "shared/trace.h"
 #if defined(RTCL_BVH_SPHERES) || defined(RTCL_BVH_KDOP) || defined(RTCL_BVH_OBB)
 #define RTCL_BVH_FILTERS
@@ -113,23 +114,7 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
       int8 hit = intersect_boxes8(node, s, h->t_best, &t_entry);
 #endif
       if (rtcl_any8(hit)) {
-        int base = sp;
-        /* insertion into [base, sp) kept sorted by decreasing distance */
-#define BVH_PUSH_LANE(k)                                     \
-  if (hit.s##k) {                                            \
-    float t = t_entry.s##k;                                  \
-    int j = sp++;                                            \
-    while (!RTCL_ANY_HIT && j > base && stack_t[j - 1] < t) {     \
-      stack_t[j] = stack_t[j - 1];                           \
-      stack_ref[j] = stack_ref[j - 1];                       \
-      --j;                                                   \
-    }                                                        \
-    stack_t[j] = t;                                          \
-    stack_ref[j] = node->child[k];                           \
-  }
-        BVH_PUSH_LANE(0) BVH_PUSH_LANE(1) BVH_PUSH_LANE(2) BVH_PUSH_LANE(3)
-        BVH_PUSH_LANE(4) BVH_PUSH_LANE(5) BVH_PUSH_LANE(6) BVH_PUSH_LANE(7)
-#undef BVH_PUSH_LANE
+        RTCL_BVH8_PUSH_CHILDREN
       }
     } else {
       int leaf = ~ref;

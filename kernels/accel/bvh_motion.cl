@@ -18,6 +18,7 @@
  *
  * Ray times: ray i's time is times[i * time_stride + time_offset], a
  * fraction of the shutter interval, clamped to [0, 1] (NaN: 0). */
+#include "shared/bvh8_stack.h"
 #include "shared/trace.h"
 
 #ifndef RTCL_STACK_SIZE
@@ -62,23 +63,7 @@ __attribute__((noinline)) void bvh_motion_traverse(const TraceRay* s, HitState* 
       int8 hit = t_entry <= t_exit;
       if (rtcl_any8(hit)) {
         global const Bvh8Node* node = nodes + ref;
-        int base = sp;
-        /* insertion into [base, sp) kept sorted by decreasing distance */
-#define MOTION_PUSH_LANE(k)                                   \
-  if (hit.s##k) {                                             \
-    float t = t_entry.s##k;                                   \
-    int j = sp++;                                             \
-    while (!RTCL_ANY_HIT && j > base && stack_t[j - 1] < t) { \
-      stack_t[j] = stack_t[j - 1];                            \
-      stack_ref[j] = stack_ref[j - 1];                        \
-      --j;                                                    \
-    }                                                         \
-    stack_t[j] = t;                                           \
-    stack_ref[j] = node->child[k];                            \
-  }
-        MOTION_PUSH_LANE(0) MOTION_PUSH_LANE(1) MOTION_PUSH_LANE(2) MOTION_PUSH_LANE(3)
-        MOTION_PUSH_LANE(4) MOTION_PUSH_LANE(5) MOTION_PUSH_LANE(6) MOTION_PUSH_LANE(7)
-#undef MOTION_PUSH_LANE
+        RTCL_BVH8_PUSH_CHILDREN
       }
     } else {
       int leaf = ~ref;
