@@ -322,17 +322,21 @@ void Renderer::trace_batch(std::uint32_t count, double done, double total_work, 
                                            first_hits->data(), wait_list(s.last));
       });
     }
-    shade();
-    compact();
-    shadow_times();
-    trace_shadows();
-    accumulate();
-    std::swap(s.queue, s.next);
+    advance_generation();
     s.stats.generations++;
     if (progress)
       progress((done + count * std::min(1.0, (generation + 1.0) / (settings.max_depth + 1.0))) / total_work);
   }
   collect_times();
+}
+
+void Renderer::advance_generation() {
+  shade();
+  compact();
+  shadow_times();
+  trace_shadows();
+  accumulate();
+  std::swap(s_->queue, s_->next);
 }
 
 std::vector<cl_float4> Renderer::read_framebuffer(std::size_t pixels) {
@@ -370,12 +374,7 @@ std::vector<std::vector<TreeRay>> Renderer::ray_tree(const Ray& ray, const Rende
     for (std::size_t i = 0; i < rays.size(); ++i) tree.back().push_back(TreeRay{rays[i], paths[i]});
     queue_times();
     trace(tree.size() == 1);
-    shade();
-    compact();
-    shadow_times();
-    trace_shadows();
-    accumulate();
-    std::swap(s.queue, s.next);
+    advance_generation();
   }
   collect_times();
   return tree;

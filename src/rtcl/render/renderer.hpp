@@ -172,6 +172,9 @@ class Renderer {
   void queue_times();
   void shadow_times();
   void accumulate();
+  // After a generation's trace: shade, compact, the shadow rays, accumulate,
+  // and the spawned rays become the queue.
+  void advance_generation();
   void collect_times();
 };
 
