@@ -21,6 +21,7 @@
 
 #include "bench_scenes.hpp"
 #include "rtcl/beam/beam_renderer.hpp"
+#include "rtcl/render/image_metrics.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "rtcl/scene/scene_file.hpp"
@@ -87,15 +88,6 @@ Fixture& fixture() {
     return x;
   }();
   return f;
-}
-
-double display_rmse(const Image& a, const Image& b) {
-  double sum = 0.0;
-  for (std::size_t i = 0; i < a.rgb.size(); ++i) {
-    double d = std::clamp(double(a.rgb[i]), 0.0, 1.0) - std::clamp(double(b.rgb[i]), 0.0, 1.0);
-    sum += d * d;
-  }
-  return std::sqrt(sum / double(a.rgb.size()));
 }
 
 void maybe_write(const std::string& name, const Image& image) {

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "bench_scenes.hpp"
+#include "rtcl/render/image_metrics.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "rtcl/scene/scene_file.hpp"
@@ -83,15 +84,6 @@ RenderSettings settings(std::uint32_t spp, Sampler sampler, std::uint32_t seed, 
   s.seed = seed;
   s.max_depth = 5;
   return s;
-}
-
-double display_rmse(const Image& a, const Image& b) {
-  double sq = 0.0;
-  for (std::size_t i = 0; i < a.rgb.size(); ++i) {
-    double e = std::clamp(double(a.rgb[i]), 0.0, 1.0) - std::clamp(double(b.rgb[i]), 0.0, 1.0);
-    sq += e * e;
-  }
-  return std::sqrt(sq / double(a.rgb.size()));
 }
 
 struct Fixture {
