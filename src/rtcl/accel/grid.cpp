@@ -135,6 +135,20 @@ void emit(const Frame& f, const glm::dvec3& lower, const glm::dvec3& upper, rtcl
     }
 }
 
+// Appends (cell, ref) for every cell geometry's triangle `id` overlaps
+// (exact test in double).
+void emit_triangle(const Frame& f, const Geometry& geometry, std::uint32_t id, rtcl_i32 ref,
+                   std::vector<CellRef>& out) {
+  const glm::uvec3& t = geometry.triangles[id];
+  glm::dvec3 a(geometry.vertices[t.x]), b(geometry.vertices[t.y]), c(geometry.vertices[t.z]);
+  const glm::dvec3 tri[3] = {a, b, c};
+  emit(f, glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c)), ref, false,
+       [&](const glm::dvec3& lo, const glm::dvec3& hi) {
+         return triangle_box_overlap(a, b, c, 0.5 * (lo + hi), 0.5 * (hi - lo));
+       },
+       out, tri);
+}
+
 // Mean cell references per triangle of frame f over an evenly spaced
 // sample of at most `samples` of the first `triangle_count` stored
 // primitives (the exact overlap pass on the sample).
@@ -143,14 +157,7 @@ double sampled_references_per_triangle(const Frame& f, const Geometry& geometry,
   std::size_t step = std::max<std::size_t>(1, triangle_count / samples), taken = 0;
   std::vector<CellRef> out;
   for (std::size_t k = 0; k < triangle_count; k += step, ++taken) {
-    const glm::uvec3& t = geometry.triangles[ids[k]];
-    glm::dvec3 a(geometry.vertices[t.x]), b(geometry.vertices[t.y]), c(geometry.vertices[t.z]);
-    const glm::dvec3 tri[3] = {a, b, c};
-    emit(f, glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c)), 0, false,
-         [&](const glm::dvec3& lo, const glm::dvec3& hi) {
-           return triangle_box_overlap(a, b, c, 0.5 * (lo + hi), 0.5 * (hi - lo));
-         },
-         out, tri);
+    emit_triangle(f, geometry, ids[k], 0, out);
   }
   return taken ? static_cast<double>(out.size()) / static_cast<double>(taken) : 0.0;
 }
@@ -282,15 +289,7 @@ Grid build_grid(const Geometry& geometry, const GridConfig& config) {
     std::vector<CellRef>& out = parts[part];
     out.reserve((end - begin) * 4);
     for (std::size_t k = begin; k < end; ++k) {
-      const glm::uvec3& t = geometry.triangles[ids[k]];
-      glm::dvec3 a(geometry.vertices[t.x]), b(geometry.vertices[t.y]), c(geometry.vertices[t.z]);
-      glm::dvec3 lower = glm::min(a, glm::min(b, c)), upper = glm::max(a, glm::max(b, c));
-      const glm::dvec3 tri[3] = {a, b, c};
-      emit(f, lower, upper, static_cast<rtcl_i32>(k), false,
-           [&](const glm::dvec3& lo, const glm::dvec3& hi) {
-             return triangle_box_overlap(a, b, c, 0.5 * (lo + hi), 0.5 * (hi - lo));
-           },
-           out, tri);
+      emit_triangle(f, geometry, ids[k], static_cast<rtcl_i32>(k), out);
       if (out.size() > max_refs) {
         overflow[part] = 1;
         return;
