@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -134,6 +135,10 @@ std::string oracle_name() {
   auto names = accel_names();
   return std::find(names.begin(), names.end(), "bvh") != names.end() ? "bvh" : "brute";
 #endif
+}
+
+std::string repo_scene(const std::string& name) {
+  return (std::filesystem::path(__FILE__).parent_path().parent_path() / "scenes" / name).string();
 }
 
 std::string scenes_dir() {

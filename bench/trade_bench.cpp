@@ -44,11 +44,6 @@ std::uint32_t trade_size() {
   return n >= 16 && n <= 4096 ? static_cast<std::uint32_t>(n) : 128;
 }
 
-// The repository's scene files (their mesh paths point at ../shared/scenes).
-std::string repo_scene(const std::string& name) {
-  return (std::filesystem::path(__FILE__).parent_path().parent_path() / "scenes" / name).string();
-}
-
 Scene trade_scene(const std::string& name) {
   if (name == "cornell") return load_scene(repo_scene("cornell_soft.json"));
   Scene scene = load_scene(repo_scene("sibenik.json"));

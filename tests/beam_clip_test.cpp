@@ -214,7 +214,8 @@ TEST(BeamClip, SliverWithVerticesEqualInFloat) {
       poly({{97, 78.9104918}, {75.2122121, 75.2122119}, {75.212212, 75.2122119}, {97, 75.2122119}}, 0.25, 1),
       poly({{97, 75.2122119}, {75.212212, 75.2122119}, {75.212212, 21.0599101}, {97, 42.8476981}}, 0.2, 2)};
   beam::BeamSet set;
-  beam::add_beam(set, beam::rectangle(80, 72, 88, 80), polys, 0, 3);
+  const std::vector<std::uint32_t> all{0, 1, 2};
+  beam::add_beam(set, beam::rectangle(80, 72, 88, 80), polys, all);
   for (DepthOrder order : {DepthOrder::key, DepthOrder::exact}) {
     std::vector<double> host(3, 0.0), dev(3, 0.0);
     for (const auto& f : beam::clip_beams_host(polys, set, order)) host[f.polygon] += beam::signed_area(f.piece.v);

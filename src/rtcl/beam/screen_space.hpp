@@ -52,5 +52,8 @@ glm::dvec3 unproject(const ScreenSpace& screen, const glm::dvec3& inv_depth, con
 std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geometry& geometry,
                                            const glm::dmat4& to_world = glm::dmat4(1.0),
                                            const glm::dvec4* keep_plane = nullptr, double keep_margin = 0.0);
+// The same for triangle t alone: false when it is left out.
+bool screen_polygon(const ScreenSpace& screen, const Geometry& geometry, std::uint32_t t, const glm::dmat4& to_world,
+                    const glm::dvec4* keep_plane, double keep_margin, ScreenPolygon* out);
 
 }  // namespace rtcl::beam
