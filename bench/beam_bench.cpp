@@ -15,7 +15,7 @@
 // and clip_ms (beam); rays (ray); rmse: RMSE of the display values (channels
 // clamped to [0, 1] as the PNG shows them) against the ray tracer at
 // $RTCL_BENCH_BEAM_REF_SPP spp (default 1024; sibenik:
-// $RTCL_BENCH_BEAM_SIBENIK_REF_SPP, default 256), rendered once outside the
+// $RTCL_BENCH_BEAM_SIBENIK_REF_SPP, default 1024), rendered once outside the
 // timed region with another seed; rmse_glass (cornell_glass): the same over
 // the pixels the glass block covers wholly (what is seen through it). With
 // $RTCL_BENCH_BEAM_IMAGES set to a directory, each configuration's image and
@@ -59,7 +59,7 @@ struct BeamScene {
 const BeamScene beam_scenes[] = {
     {"cornell_glass", "cornell_glass_beam.json", "RTCL_BENCH_BEAM_RES", 256, "RTCL_BENCH_BEAM_REF_SPP", 1024, "glass"},
     {"sibenik_mirror", "sibenik_mirror_beam.json", "RTCL_BENCH_BEAM_SIBENIK_RES", 128,
-     "RTCL_BENCH_BEAM_SIBENIK_REF_SPP", 256, nullptr},
+     "RTCL_BENCH_BEAM_SIBENIK_REF_SPP", 1024, nullptr},
 };
 
 struct Fixture {
@@ -77,9 +77,8 @@ void maybe_write(const std::string& name, const Image& image) {
 
 Fixture& fixture(const BeamScene& bs) {
   static std::map<std::string, std::unique_ptr<Fixture>> fixtures;
-  std::unique_ptr<Fixture>& f = fixtures[bs.name];
-  if (f) return *f;
-  f = std::make_unique<Fixture>();
+  if (auto it = fixtures.find(bs.name); it != fixtures.end()) return *it->second;
+  auto f = std::make_unique<Fixture>();
   f->scene = load_scene(repo_scene(bs.file));
   f->size = env_number(bs.res_env, bs.res);
   f->renderer = std::make_unique<Renderer>(bench_device(), f->scene, "bvh");
@@ -98,7 +97,7 @@ Fixture& fixture(const BeamScene& bs) {
       if (f->scene.materials[flat.material[e.prim]].name == bs.glass) covered[e.pixel] += e.area;
     for (double a : covered) f->glass.push_back(a > 1.0 - 1e-6);
   }
-  return *f;
+  return *(fixtures[bs.name] = std::move(f));
 }
 
 // Display RMSE over the pixels marked in `mask`.
@@ -120,12 +119,13 @@ void errors(benchmark::State& state, const Fixture& f, const Image& image) {
   if (!f.glass.empty()) state.counters["rmse_glass"] = masked_rmse(image, f.reference, f.glass);
 }
 
-void beam_benchmark(benchmark::State& state, const BeamScene* bs, beam::CandidateCull cull) {
+void beam_benchmark(benchmark::State& state, const BeamScene* bs, beam::CandidateCull cull, beam::ClipKernel kernel) {
   try {
     Fixture& f = fixture(*bs);
     beam::BeamSettings s;
     s.width = s.height = f.size;
     s.cull = cull;
+    s.clip_kernel = kernel;
     Image image = beam::render_beam(bench_device(), f.scene, s);  // warm-up: kernel builds
     beam::BeamStats st;
     for (auto _ : state) {
@@ -145,7 +145,7 @@ void beam_benchmark(benchmark::State& state, const BeamScene* bs, beam::Candidat
     state.counters["pixel_pieces"] = double(st.pixel_pieces);
     state.counters["shadow_rays"] = double(st.shadow_rays);
     errors(state, f, image);
-    if (cull == beam::CandidateCull::bvh) maybe_write(std::string(bs->name) + "-beam", image);
+    if (cull == beam::CandidateCull::bvh && kernel == beam::ClipKernel::item_per_beam) maybe_write(std::string(bs->name) + "-beam", image);
     state.SetLabel(bench_device().info().name);
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
@@ -176,11 +176,16 @@ void ray_benchmark(benchmark::State& state, const BeamScene* bs, std::uint32_t s
 [[maybe_unused]] const bool registered = [] {
   for (const BeamScene& bs : beam_scenes) {
     const std::string scene = bs.name;
-    benchmark::RegisterBenchmark(("beam/" + scene).c_str(), beam_benchmark, &bs, beam::CandidateCull::bvh)
+    benchmark::RegisterBenchmark(("beam/" + scene).c_str(), beam_benchmark, &bs, beam::CandidateCull::bvh,
+                                 beam::ClipKernel::item_per_beam)
+        ->UseManualTime()
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("beam/" + scene + "/kernel:group").c_str(), beam_benchmark, &bs,
+                                 beam::CandidateCull::bvh, beam::ClipKernel::group_per_beam)
         ->UseManualTime()
         ->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("beam/" + scene + "/cull:all").c_str(), beam_benchmark, &bs,
-                                 beam::CandidateCull::all)
+                                 beam::CandidateCull::all, beam::ClipKernel::item_per_beam)
         ->UseManualTime()
         ->Iterations(1)
         ->Unit(benchmark::kMillisecond);

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -138,7 +137,7 @@ std::string oracle_name() {
 }
 
 std::string repo_scene(const std::string& name) {
-  return (std::filesystem::path(__FILE__).parent_path().parent_path() / "scenes" / name).string();
+  return std::string(RTCL_BENCH_REPO_SCENES) + "/" + name;
 }
 
 std::string scenes_dir() {
