@@ -119,13 +119,12 @@ void errors(benchmark::State& state, const Fixture& f, const Image& image) {
   if (!f.glass.empty()) state.counters["rmse_glass"] = masked_rmse(image, f.reference, f.glass);
 }
 
-void beam_benchmark(benchmark::State& state, const BeamScene* bs, beam::CandidateCull cull, beam::ClipKernel kernel) {
+void beam_benchmark(benchmark::State& state, const BeamScene* bs, beam::CandidateCull cull) {
   try {
     Fixture& f = fixture(*bs);
     beam::BeamSettings s;
     s.width = s.height = f.size;
     s.cull = cull;
-    s.clip_kernel = kernel;
     Image image = beam::render_beam(bench_device(), f.scene, s);  // warm-up: kernel builds
     beam::BeamStats st;
     for (auto _ : state) {
@@ -145,7 +144,7 @@ void beam_benchmark(benchmark::State& state, const BeamScene* bs, beam::Candidat
     state.counters["pixel_pieces"] = double(st.pixel_pieces);
     state.counters["shadow_rays"] = double(st.shadow_rays);
     errors(state, f, image);
-    if (cull == beam::CandidateCull::bvh && kernel == beam::ClipKernel::item_per_beam) maybe_write(std::string(bs->name) + "-beam", image);
+    if (cull == beam::CandidateCull::bvh) maybe_write(std::string(bs->name) + "-beam", image);
     state.SetLabel(bench_device().info().name);
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
@@ -176,16 +175,11 @@ void ray_benchmark(benchmark::State& state, const BeamScene* bs, std::uint32_t s
 [[maybe_unused]] const bool registered = [] {
   for (const BeamScene& bs : beam_scenes) {
     const std::string scene = bs.name;
-    benchmark::RegisterBenchmark(("beam/" + scene).c_str(), beam_benchmark, &bs, beam::CandidateCull::bvh,
-                                 beam::ClipKernel::item_per_beam)
-        ->UseManualTime()
-        ->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark(("beam/" + scene + "/kernel:group").c_str(), beam_benchmark, &bs,
-                                 beam::CandidateCull::bvh, beam::ClipKernel::group_per_beam)
+    benchmark::RegisterBenchmark(("beam/" + scene).c_str(), beam_benchmark, &bs, beam::CandidateCull::bvh)
         ->UseManualTime()
         ->Unit(benchmark::kMillisecond);
     benchmark::RegisterBenchmark(("beam/" + scene + "/cull:all").c_str(), beam_benchmark, &bs,
-                                 beam::CandidateCull::all, beam::ClipKernel::item_per_beam)
+                                 beam::CandidateCull::all)
         ->UseManualTime()
         ->Iterations(1)
         ->Unit(benchmark::kMillisecond);

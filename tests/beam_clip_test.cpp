@@ -19,7 +19,6 @@
 #include "rtcl/beam/tile_beams.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/render/camera.hpp"
-#include "rtcl/scene/scene_file.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"
 
@@ -262,26 +261,6 @@ TEST(BeamClip, ABeamOverThePieceLimitIsCutIntoQuarters) {
   for (std::size_t p = 0; p < polys.size(); ++p) {
     EXPECT_NEAR(host[p], 0.15, 1e-9) << p;
     EXPECT_NEAR(dev[p], host[p], 1e-3) << p;
-  }
-}
-
-TEST(BeamClip, GroupPerBeamKernelMatchesItemPerBeam) {
-  // The same walk with the later candidates' tests spread over a work-group:
-  // the same fragments (the same float operations in the same order).
-  Scene scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_glass_beam.json");
-  FlatScene flat = flatten(scene);
-  beam::ScreenSpace screen = beam::screen_space(camera_frame(scene.camera, 48, 48), 48, 48, flat.geometry);
-  std::vector<beam::ScreenPolygon> polys = beam::screen_polygons(screen, flat.geometry);
-  beam::BeamSet tb = beam::tile_beams(polys, 48, 48);
-  auto a = beam::clip_beams_device(test_device(), polys, tb, DepthOrder::exact, nullptr, beam::ClipKernel::item_per_beam);
-  auto b = beam::clip_beams_device(test_device(), polys, tb, DepthOrder::exact, nullptr, beam::ClipKernel::group_per_beam);
-  ASSERT_EQ(a.size(), b.size());
-  ASSERT_GT(a.size(), 0u);
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].beam, b[i].beam);
-    EXPECT_EQ(a[i].polygon, b[i].polygon);
-    ASSERT_EQ(a[i].count, b[i].count);
-    for (std::uint32_t k = 0; k < a[i].count; ++k) EXPECT_EQ(a[i].x[k], b[i].x[k]);
   }
 }
 

@@ -177,17 +177,8 @@ inline void report(global volatile uint* status, global uint* over_limit, int co
 kernel void clip_beams(global const BeamPolygon* polygons, global const Beam* beams, global const uint* candidates,
                        uint beam_count, uint exact, float min_area_fraction, global BeamFragment* fragments,
                        uint capacity, global volatile uint* status, global uint* over_limit) {
-#ifndef RTCL_BEAM_GROUP
   uint ti = get_global_id(0);
   if (ti >= beam_count) return;
-  const int writer = 1;
-#else
-  /* One work-group per beam; its work-items share the later-candidate tests
-   * of the exact order and all hold the beam's state; work-item 0 writes. */
-  uint ti = get_group_id(0);
-  local Piece fronts[RTCL_BEAM_GROUP];
-  const int writer = get_local_id(0) == 0;
-#endif
   global const Beam* t = beams + ti;
   const float2 origin = (float2)(t->x0, t->y0);
   Piece beam[RTCL_BEAM_MAX_PIECES], next[RTCL_BEAM_MAX_PIECES], kept[RTCL_BEAM_MAX_PIECES],
@@ -219,7 +210,6 @@ kernel void clip_beams(global const BeamPolygon* polygons, global const Beam* be
       }
       uint nk = 1, gave_up = 0;
       kept[0] = f;
-#ifndef RTCL_BEAM_GROUP
       for (uint l = c + 1; exact && l < count && nk > 0 && r == CLIP_OK; ++l) {
         uint qi = candidates[first + l];
         load_polygon(polygons + qi, origin, &q, merge);
@@ -232,40 +222,8 @@ kernel void clip_beams(global const BeamPolygon* polygons, global const Beam* be
         for (uint k = 0; k < nk; ++k) area_after += piece_area(kept + k);
         if (nk != before || area_after != area_before) gave_up = 1;
       }
-#else
-      /* The later candidates in chunks of the group's size: work-item j
-       * clips candidate base + j to where it is nearer and tests its box
-       * against the fragment's; then every work-item subtracts the hits in
-       * order (the same state in all of them). */
-      for (uint base = c + 1; exact && base < count && nk > 0 && r == CLIP_OK; base += RTCL_BEAM_GROUP) {
-        uint l = base + get_local_id(0);
-        Piece mine;
-        mine.n = 0;
-        if (l < count) {
-          uint qi = candidates[first + l];
-          load_polygon(polygons + qi, origin, &q, merge);
-          int rl = clip_piece(&q, local_inv_depth(polygons + qi, origin) - pd, &mine, merge);
-          if (rl != CLIP_OK) mine.n = RTCL_BEAM_PIECE_VERTS + 1; /* the limit: reported below */
-          else if (mine.n >= 3 && disjoint_boxes(&mine, &f)) mine.n = 0;
-        }
-        fronts[get_local_id(0)] = mine;
-        barrier(CLK_LOCAL_MEM_FENCE);
-        for (uint j = 0; j < RTCL_BEAM_GROUP && base + j < count && nk > 0 && r == CLIP_OK; ++j) {
-          front = fronts[j];
-          if (front.n > RTCL_BEAM_PIECE_VERTS) r = CLIP_VERTS;
-          if (r != CLIP_OK || front.n < 3) continue;
-          uint before = nk;
-          float area_before = 0.0f, area_after = 0.0f;
-          for (uint k = 0; k < nk; ++k) area_before += piece_area(kept + k);
-          r = subtract_range(kept, 0, &nk, &front, min_area, scratch, &rest, &tmp, merge);
-          for (uint k = 0; k < nk; ++k) area_after += piece_area(kept + k);
-          if (nk != before || area_after != area_before) gave_up = 1;
-        }
-        barrier(CLK_LOCAL_MEM_FENCE);
-      }
-#endif
       if (r != CLIP_OK) break;
-      for (uint k = 0; writer && k < nk; ++k) {
+      for (uint k = 0; k < nk; ++k) {
         uint slot = atomic_inc(status + RTCL_BEAM_STATUS_FRAGMENTS);
         if (slot >= capacity) continue;
         global BeamFragment* out = fragments + slot;
@@ -290,5 +248,5 @@ kernel void clip_beams(global const BeamPolygon* polygons, global const Beam* be
     for (uint i = 0; i < nn; ++i) beam[i] = next[i];
     nb = nn;
   }
-  if (r != CLIP_OK && writer) report(status, over_limit, r, ti);
+  if (r != CLIP_OK) report(status, over_limit, r, ti);
 }

@@ -44,10 +44,7 @@ std::vector<BeamFragment> clip_once(const Device& device, const std::vector<Beam
   cl::Buffer polys = device.upload(packed.data(), packed.size() * sizeof(BeamPolygon), "beam polygons");
   cl::Buffer tiles = device.upload(tb.beams.data(), tb.beams.size() * sizeof(Beam), "beams");
   cl::Buffer cands = device.upload(candidates.data(), candidates.size() * sizeof(std::uint32_t), "beam candidates");
-  const bool grouped = st.kernel == ClipKernel::group_per_beam;
-  cl::Program program = device.program(
-      "render/beam_clip.cl", grouped ? std::vector<std::string>{"RTCL_BEAM_GROUP=" + std::to_string(clip_group)}
-                                     : std::vector<std::string>{});
+  cl::Program program = device.program("render/beam_clip.cl", {});
   cl::Kernel kernel(program, "clip_beams");
   // First guess: a few fragments per candidate; the kernel counts what it needed.
   std::size_t capacity = std::max<std::size_t>(1024, 2 * tb.candidates.size());
@@ -75,8 +72,7 @@ std::vector<BeamFragment> clip_once(const Device& device, const std::vector<Beam
     // A small work-group: each work-item holds four regions of pieces
     // (about 17 KB) in private memory, which PoCL replicates per work-item
     // of a group on one thread's stack.
-    const std::size_t group = grouped ? clip_group : 4,
-                      global = grouped ? tb.beams.size() * group : (tb.beams.size() + group - 1) / group * group;
+    const std::size_t group = 4, global = (tb.beams.size() + group - 1) / group * group;
     check_cl(device.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(group),
                                                  nullptr, &done),
              "clEnqueueNDRangeKernel(clip_beams)");
@@ -170,10 +166,8 @@ std::vector<BeamFragment> clip_split(const Device& device, const std::vector<Scr
 }  // namespace
 
 std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vector<ScreenPolygon>& polygons,
-                                            const BeamSet& tb, DepthOrder order, DeviceClipStats* stats,
-                                            ClipKernel kernel) {
+                                            const BeamSet& tb, DepthOrder order, DeviceClipStats* stats) {
   DeviceClipStats st;
-  st.kernel = kernel;
   if (tb.beams.empty()) return {};
   std::vector<BeamPolygon> packed = pack(polygons);
   if (packed.empty()) packed.push_back(BeamPolygon{});  // no zero-sized buffers

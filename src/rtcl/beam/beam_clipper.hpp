@@ -24,14 +24,7 @@ inline constexpr float device_min_area_fraction = 1e-6f;
 // least this wide (pixels).
 inline constexpr double min_split_px = 1.0 / 64.0;
 
-// How the kernel spreads the work: one work-item per beam (the beams of a
-// set in parallel), or one work-group of clip_group work-items per beam
-// (the exact order's tests of the later candidates in parallel).
-enum class ClipKernel { item_per_beam, group_per_beam };
-inline constexpr std::size_t clip_group = 8;
-
 struct DeviceClipStats {
-  ClipKernel kernel = ClipKernel::item_per_beam;
   double clip_ms = 0.0;             // device time of the kernels (0 without profiling)
   std::size_t fragments = 0;        // convex fragment pieces written
   std::size_t launches = 0;         // one per set of beams, plus one per fragment buffer that had to grow
@@ -49,7 +42,6 @@ struct DeviceClipStats {
 // buffer of the size counted).
 std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vector<ScreenPolygon>& polygons,
                                             const BeamSet& beams, DepthOrder order,
-                                            DeviceClipStats* stats = nullptr,
-                                            ClipKernel kernel = ClipKernel::item_per_beam);
+                                            DeviceClipStats* stats = nullptr);
 
 }  // namespace rtcl::beam

@@ -216,7 +216,7 @@ Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene
     ++v.stats.levels;
     v.stats.candidates += level.candidates.size();
     DeviceClipStats cs;
-    std::vector<BeamFragment> frags = clip_beams_device(device, v.polygons, level, s.order, &cs, s.clip_kernel);
+    std::vector<BeamFragment> frags = clip_beams_device(device, v.polygons, level, s.order, &cs);
     v.stats.fragments += frags.size();
     v.stats.clip_ms += cs.clip_ms;
     BeamSet next;

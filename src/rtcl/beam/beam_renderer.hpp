@@ -28,7 +28,6 @@
 #include <string>
 
 #include "rtcl/beam/beam_clip_host.hpp"
-#include "rtcl/beam/beam_clipper.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/render/image.hpp"
 #include "rtcl/scene/scene.hpp"
@@ -46,7 +45,6 @@ struct BeamSettings {
   std::uint32_t max_depth = 5;  // beam-tree levels below the viewing beam (the ray tracer's --depth)
   float min_weight = 1e-3f;     // a child beam whose weight's largest component is below this is not traced
   CandidateCull cull = CandidateCull::bvh;
-  ClipKernel clip_kernel = ClipKernel::item_per_beam;
   std::string accel = "bvh";  // structure of the shadow rays
 };
 
