@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Beam tracing against the ray tracer (bench/beam_bench.cpp): prints one
-Markdown table per scene (median frame time over repetitions, errors, beam
-and fragment counts, candidate-cull time) and plots error against time per
+Markdown table per scene (median frame time and candidate-cull time over
+repetitions, errors, beam and fragment counts) and plots error against time per
 scene, the ray tracer's spp as a line and the beam tracer as a point.
 
     python3 bench/plot_beam.py beam.json -o docs/beam-trade.png \
@@ -23,7 +23,7 @@ SCENES = ["cornell_glass", "sibenik_mirror"]
 def load(path):
     with open(path) as f:
         data = json.load(f)
-    times, last = defaultdict(list), {}
+    times, culls, last = defaultdict(list), defaultdict(list), {}
     for b in data.get("benchmarks", []):
         if b.get("run_type") == "aggregate" or b.get("error_occurred"):
             continue
@@ -31,7 +31,11 @@ def load(path):
         if not (name.startswith("beam/") or name.startswith("ray/")):
             continue
         times[name].append(b["frame_ms"])
+        if "cull_ms" in b:
+            culls[name].append(b["cull_ms"])
         last[name] = b
+    for n, c in culls.items():
+        last[n]["cull_ms"] = statistics.median(c)
     return {n: (statistics.median(t), last[n]) for n, t in times.items()}
 
 
