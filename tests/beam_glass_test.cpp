@@ -16,6 +16,7 @@
 #include "rtcl/error.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/scene/scene_file.hpp"
+#include "support/cli_run.hpp"
 #include "support/error_of.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference_renderer.hpp"
@@ -156,6 +157,27 @@ TEST(BeamGlass, TotalInternalReflectionInAPrism) {
   // lost reflected weight would show the background instead of the wall.
   EXPECT_LT(c.beam.max_error_unmasked, 1e-2);
   EXPECT_LT(c.beam.rmse, 1e-2);
+}
+
+TEST(BeamGlass, CommandLine) {
+  TempDir dir;
+  const std::string scenes = std::string(RTCL_SOURCE_DIR) + "/scenes/";
+  CliRun ok = run_cli(dir, {"render", scenes + "cornell_glass_beam.json", "--method", "beam", "-o", "glass.png",
+                            "--width", "24"});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_NE(ok.out.find("refraction linearised, one M_t per beam"), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("refracted beams"), std::string::npos) << ok.out;
+  // A glossy glass: one message naming the scene and the material, exit 1, no image.
+  const std::string glossy = dir.write(
+      "glossy.json", "{\"camera\": {\"position\": [0, 1, 3.9], \"look_at\": [0, 1, 0]},\n"
+                     " \"lights\": [{\"position\": [0, 1.9, 0]}],\n"
+                     " \"materials\": {\"frosted\": {\"kt\": 0.9, \"roughness\": 0.3}},\n"
+                     " \"objects\": [{\"type\": \"mesh\", \"file\": \"" + scenes + "glass_block.obj\", "
+                     "\"material\": \"frosted\"}]}\n");
+  expect_failure(run_cli(dir, {"render", glossy, "--method", "beam", "-o", "g.png", "--width", "16"}),
+                 "glossy.json: material 'frosted' is glossy; --method beam traces mirror reflection and refraction "
+                 "only (use --method ray)",
+                 dir, "g.png");
 }
 
 TEST(BeamGlass, GlossyMaterialsAreRefused) {

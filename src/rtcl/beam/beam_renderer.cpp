@@ -179,14 +179,36 @@ class Tree {
   std::vector<std::uint32_t> prims_;
 };
 
-// A fragment's children: the reflected beam (weight kr + kt F) and the
-// refracted beam (weight kt (1 - F)), F the ray tracer's Fresnel term
-// (kernels/render/shade.cl) for the fragment's central ray: the ray through
-// the centroid of its cross-section. Under total internal reflection F = 1.
+// A child beam of a fragment: its world and weight.
 struct Child {
   std::uint32_t world;
   dvec3 weight;
 };
+
+// Refraction at a fragment of a transmissive polygon (plane: its real-world
+// plane), decided by the fragment's central ray, from the eye through the
+// centroid of its cross-section: F, the ray tracer's Fresnel reflectance
+// (kernels/render/shade.cl; 1 under total internal reflection), and M_t
+// (none under total internal reflection).
+struct Refraction {
+  double F = 1.0;
+  std::optional<glm::dmat4> bend;
+};
+Refraction refraction_at(const ScreenSpace& screen, const World& world, const ScreenPolygon& polygon,
+                         const glm::dvec4& plane, const dvec2& centre, double ior) {
+  const dvec3 eye = screen.frame.origin;
+  const dvec3 through = unproject(screen, polygon.inv_depth, centre);
+  const dvec3 incident = glm::normalize(glm::dmat3(world.to_real) * (through - eye));
+  double cos_i = -glm::dot(incident, dvec3(plane));
+  const double eta = cos_i > 0.0 ? 1.0 / ior : ior;  // arriving on the normal's side: entering
+  cos_i = std::abs(cos_i);
+  const double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+  Refraction r;
+  if (!(sin2_t < 1.0)) return r;
+  r.bend = refraction_matrix(plane, incident, eta);
+  if (r.bend) r.F = fresnel_dielectric(cos_i, std::sqrt(1.0 - sin2_t), eta);
+  return r;
+}
 
 // The beam tree, level by level: one device launch per level.
 Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene& flat, const BeamSettings& s,
@@ -232,31 +254,20 @@ Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene
       const Material& m = scene.materials[flat.material[prim]];
       const double area = signed_area(piece.v);  // 0 for a piece collinear in double: no child
       if (primary_only || bi.depth >= s.max_depth || !(area > 0.0)) continue;
+      // Children with the ray tracer's weights: reflected kr + kt F,
+      // refracted kt (1 - F).
       std::vector<Child> children;
       dvec3 reflected = bi.weight * dvec3(m.kr);
       if (m.transmissive()) {
-        const World& wd = v.worlds[bi.world];
-        const dvec3 eye = v.screen.frame.origin;
-        const dvec3 through = unproject(v.screen, v.polygons[f.polygon].inv_depth, centroid(piece, area));
-        const dvec3 incident = glm::normalize(glm::dmat3(wd.to_real) * (through - eye));
-        const glm::dvec4 plane = tree.real_plane(prim);
-        double cos_i = -glm::dot(incident, dvec3(plane));
-        const double eta = cos_i > 0.0 ? 1.0 / double(m.ior) : double(m.ior);  // entering the front side
-        cos_i = std::abs(cos_i);
-        const double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
-        double F = 1.0;
-        std::optional<glm::dmat4> bend = sin2_t < 1.0 ? refraction_matrix(plane, incident, eta) : std::nullopt;
-        if (bend) {
-          F = fresnel_dielectric(cos_i, std::sqrt(1.0 - sin2_t), eta);
-          dvec3 refracted = bi.weight * dvec3(m.kt) * (1.0 - F);
-          if (heavy(refracted)) {
-            children.push_back({tree.add_world(bi.world, prim, *bend), refracted});
-            ++v.stats.refracted_beams;
-          }
-        } else {
-          ++v.stats.total_internal_reflections;
+        Refraction r = refraction_at(v.screen, v.worlds[bi.world], v.polygons[f.polygon], tree.real_plane(prim),
+                                     centroid(piece, area), double(m.ior));
+        if (!r.bend) ++v.stats.total_internal_reflections;
+        const dvec3 refracted = bi.weight * dvec3(m.kt) * (1.0 - r.F);
+        if (r.bend && heavy(refracted)) {
+          children.push_back({tree.add_world(bi.world, prim, *r.bend), refracted});
+          ++v.stats.refracted_beams;
         }
-        reflected += bi.weight * dvec3(m.kt) * F;
+        reflected += bi.weight * dvec3(m.kt) * r.F;
       }
       if (heavy(reflected)) {
         auto key = std::make_pair(bi.world, prim);
