@@ -159,6 +159,58 @@ TEST(BeamGlass, TotalInternalReflectionInAPrism) {
   EXPECT_LT(c.beam.rmse, 1e-2);
 }
 
+// A glass slab (z in [-0.1, 0.1], index 1.5, kt 0.9) before an emitting wall
+// (radiance 1), seen head-on through a 2-degree field of view: every pixel's
+// radiance is a closed form of the weights.
+TEST(BeamGlass, SlabWeightsAreTheFresnelSeries) {
+  Scene scene;
+  scene.source = "slab";
+  scene.camera.position = {0.0f, 0.0f, 5.0f};
+  scene.camera.look_at = {0.0f, 0.0f, 0.0f};
+  scene.camera.fov_deg = 2.0f;
+  scene.ambient = glm::vec3(0.0f);
+  scene.background = glm::vec3(0.0f);
+  Material glass;
+  glass.name = "glass";
+  glass.diffuse = glm::vec3(0.0f);
+  glass.kt = glm::vec3(0.9f);
+  glass.ior = 1.5f;
+  Material wall;
+  wall.name = "wall";
+  wall.diffuse = glm::vec3(0.0f);
+  wall.emission = glm::vec3(1.0f);
+  scene.materials = {glass, wall};
+  SceneMesh m;
+  m.name = "slab and wall";
+  m.vertices = {{-10, -10, 0.1f}, {10, -10, 0.1f}, {10, 10, 0.1f}, {-10, 10, 0.1f},
+                {-10, -10, -0.1f}, {10, -10, -0.1f}, {10, 10, -0.1f}, {-10, 10, -0.1f},
+                {-10, -10, -5}, {10, -10, -5}, {10, 10, -5}, {-10, 10, -5}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3},     // front face, normal +z
+                 {4, 6, 5}, {4, 7, 6},     // back face, normal -z (outward)
+                 {8, 9, 10}, {8, 10, 11}};  // wall, facing the slab
+  m.materials = {0, 0, 0, 0, 1, 1};
+  scene.meshes.push_back(m);
+  beam::BeamSettings bs;
+  bs.width = bs.height = 16;
+  bs.min_weight = 1e-4f;  // the second term's beams weigh 9.7e-4
+  beam::BeamStats st;
+  Image image = beam::render_beam(test_device(), scene, bs, &st);
+  // Normal incidence: F = ((1.5 - 1) / (1.5 + 1))^2 = 0.04 entering and
+  // leaving. Through: kt (1 - F) twice. Reflected inside at the back face
+  // and again at the front (kt F each), then through: one more term, at
+  // depth 4; the next needs depth 6 > 5. The rays are at most 1.4 degrees
+  // off the axis, where F differs from 0.04 by under 1e-4 relative.
+  const double F = 0.04, kt = 0.9, through = kt * (1.0 - F) * kt * (1.0 - F);
+  const double want = through * (1.0 + (kt * F) * (kt * F));
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) EXPECT_NEAR(image.rgb[i], want, 1e-4 * want) << i;
+  EXPECT_EQ(st.total_internal_reflections, 0u);
+  EXPECT_GT(st.refracted_beams, 0u);
+  // Without the second term (depth 3) the image is darker by exactly it.
+  bs.max_depth = 3;
+  Image shallow = beam::render_beam(test_device(), scene, bs);
+  for (std::size_t i = 0; i < shallow.rgb.size(); ++i) EXPECT_NEAR(shallow.rgb[i], through, 1e-4 * through) << i;
+}
+
 TEST(BeamGlass, CommandLine) {
   TempDir dir;
   const std::string scenes = std::string(RTCL_SOURCE_DIR) + "/scenes/";
