@@ -1,7 +1,11 @@
 // Beam tracing against the ray tracer: the speed/accuracy trade on
 //   cornell_glass    scenes/cornell_glass_beam.json (a mirror tall block, a
-//                    glass short block of index 1.5, point light), size
+//                    glass block of index 1.5, point light), size
 //                    $RTCL_BENCH_BEAM_RES squared (default 256);
+//   cornell_glass_ior1  the same with the glass of index 1, where the
+//                    linearised M_t is exact (the identity): what the beam
+//                    tracer's error through the glass is without the
+//                    linearisation;
 //   sibenik_mirror   scenes/sibenik_mirror_beam.json (75k triangles, a mirror
 //                    floor), size $RTCL_BENCH_BEAM_SIBENIK_RES squared
 //                    (default 128).
@@ -50,6 +54,7 @@ std::uint32_t env_number(const char* name, std::uint32_t fallback) {
 struct BeamScene {
   const char* name;
   const char* file;
+  float ior;  // > 0: every transmissive material's index of refraction replaced (1: M_t exact)
   const char* res_env;
   std::uint32_t res;
   const char* ref_env;
@@ -57,8 +62,11 @@ struct BeamScene {
   const char* glass;  // material whose covered pixels make rmse_glass, or nullptr
 };
 const BeamScene beam_scenes[] = {
-    {"cornell_glass", "cornell_glass_beam.json", "RTCL_BENCH_BEAM_RES", 256, "RTCL_BENCH_BEAM_REF_SPP", 1024, "glass"},
-    {"sibenik_mirror", "sibenik_mirror_beam.json", "RTCL_BENCH_BEAM_SIBENIK_RES", 128,
+    {"cornell_glass", "cornell_glass_beam.json", 0.0f, "RTCL_BENCH_BEAM_RES", 256, "RTCL_BENCH_BEAM_REF_SPP", 1024,
+     "glass"},
+    {"cornell_glass_ior1", "cornell_glass_beam.json", 1.0f, "RTCL_BENCH_BEAM_RES", 256, "RTCL_BENCH_BEAM_REF_SPP",
+     1024, "glass"},
+    {"sibenik_mirror", "sibenik_mirror_beam.json", 0.0f, "RTCL_BENCH_BEAM_SIBENIK_RES", 128,
      "RTCL_BENCH_BEAM_SIBENIK_REF_SPP", 1024, nullptr},
 };
 
@@ -80,6 +88,9 @@ Fixture& fixture(const BeamScene& bs) {
   if (auto it = fixtures.find(bs.name); it != fixtures.end()) return *it->second;
   auto f = std::make_unique<Fixture>();
   f->scene = load_scene(repo_scene(bs.file));
+  if (bs.ior > 0.0f)
+    for (Material& m : f->scene.materials)
+      if (m.transmissive()) m.ior = bs.ior;
   f->size = env_number(bs.res_env, bs.res);
   f->renderer = std::make_unique<Renderer>(bench_device(), f->scene, "bvh");
   RenderSettings s;

@@ -17,7 +17,7 @@ import json
 import statistics
 from collections import defaultdict
 
-SCENES = ["cornell_glass", "sibenik_mirror"]
+SCENES = ["cornell_glass", "cornell_glass_ior1", "sibenik_mirror"]
 
 
 def load(path):
