@@ -136,6 +136,10 @@ std::string oracle_name() {
 #endif
 }
 
+std::string repo_scene(const std::string& name) {
+  return std::string(RTCL_BENCH_REPO_SCENES) + "/" + name;
+}
+
 std::string scenes_dir() {
   if (const char* dir = std::getenv("RTCL_SCENES_DIR"); dir && *dir) return dir;
   return RTCL_BENCH_SCENES_DIR;

@@ -42,6 +42,10 @@ Query ray_kind_query(RayKind kind);
 // $RTCL_SCENES_DIR, else the ../shared/scenes beside the source tree.
 std::string scenes_dir();
 
+// The repository's scene file scenes/<name> (their mesh paths point at
+// ../shared/scenes).
+std::string repo_scene(const std::string& name);
+
 // Image width = height in pixels: $RTCL_BENCH_RES, default 1024.
 int image_size();
 

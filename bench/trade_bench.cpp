@@ -22,7 +22,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <map>
 #include <memory>
 #include <string>
@@ -42,11 +41,6 @@ std::uint32_t trade_size() {
   if (!value || !*value) return 128;
   long n = std::strtol(value, nullptr, 10);
   return n >= 16 && n <= 4096 ? static_cast<std::uint32_t>(n) : 128;
-}
-
-// The repository's scene files (their mesh paths point at ../shared/scenes).
-std::string repo_scene(const std::string& name) {
-  return (std::filesystem::path(__FILE__).parent_path().parent_path() / "scenes" / name).string();
 }
 
 Scene trade_scene(const std::string& name) {

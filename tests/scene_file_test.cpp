@@ -65,7 +65,8 @@ TEST(SceneFile, ShippedScenesLoad) {
   FlatScene flat = flatten(cornell);
   EXPECT_EQ(flat.geometry.primitive_count(), 38u);
   EXPECT_EQ(flat.material.size(), 38u);
-  for (const char* name : {"/scenes/sibenik.json", "/scenes/sponza.json", "/scenes/cornell_soft.json"})
+  for (const char* name : {"/scenes/sibenik.json", "/scenes/sponza.json", "/scenes/cornell_soft.json",
+                           "/scenes/sibenik_mirror_beam.json", "/scenes/cornell_glass_beam.json"})
     EXPECT_NO_THROW(load_scene(std::string(RTCL_SOURCE_DIR) + name)) << name;
 }
 

@@ -13,7 +13,8 @@
  * extent clipped to the screen; polygons arrive clipped to it). Pieces below
  * min_area_fraction * the beam's area are dropped. Limits (beam_layouts.h): a
  * region of more than RTCL_BEAM_MAX_PIECES pieces or a piece of more than
- * RTCL_BEAM_PIECE_VERTS vertices stops the beam and is counted in status;
+ * RTCL_BEAM_PIECE_VERTS vertices stops the beam, is counted in status and
+ * marks over_limit[beam] (the host splits such a beam and clips again);
  * fragments beyond `capacity` are counted, not written: the host reports or
  * retries, nothing is cut silently. */
 #include "shared/layouts.h"
@@ -167,14 +168,15 @@ inline float3 local_inv_depth(global const BeamPolygon* p, float2 origin) {
   return (float3)(a, b, p->inv_depth[2] + a * origin.x + b * origin.y);
 }
 
-inline void report(global volatile uint* status, int code, uint tile) {
+inline void report(global volatile uint* status, global uint* over_limit, int code, uint tile) {
   atomic_inc(status + (code == CLIP_PIECES ? RTCL_BEAM_STATUS_PIECE_OVERFLOW : RTCL_BEAM_STATUS_VERT_OVERFLOW));
   atomic_min(status + RTCL_BEAM_STATUS_FIRST_TILE, tile);
+  over_limit[tile] = 1;
 }
 
 kernel void clip_beams(global const BeamPolygon* polygons, global const Beam* beams, global const uint* candidates,
                        uint beam_count, uint exact, float min_area_fraction, global BeamFragment* fragments,
-                       uint capacity, global volatile uint* status) {
+                       uint capacity, global volatile uint* status, global uint* over_limit) {
   uint ti = get_global_id(0);
   if (ti >= beam_count) return;
   global const Beam* t = beams + ti;
@@ -246,5 +248,5 @@ kernel void clip_beams(global const BeamPolygon* polygons, global const Beam* be
     for (uint i = 0; i < nn; ++i) beam[i] = next[i];
     nb = nn;
   }
-  if (r != CLIP_OK) report(status, r, ti);
+  if (r != CLIP_OK) report(status, over_limit, r, ti);
 }

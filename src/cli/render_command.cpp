@@ -97,13 +97,15 @@ void run_beam(const RenderOptions& o) {
   beam::BeamStats st;
   Image image = beam::render_beam(device, scene, bs, &st);
   write_image(o.output, image);
-  std::printf("rtcl render: %s (%ux%u, beam tracing, %s depth order, exact pixel coverage, reflection beams to "
-              "depth %u, no refraction beams, point-light shadows by shadow rays through %s, %s): %zu polygons, "
-              "%zu tile beams of 8x8 px + %zu reflected beams in %u levels, %zu candidates, %zu fragments, %zu pixel "
-              "pieces, %zu shadow rays in %.3f s (clipping kernels %.1f ms)\n",
+  std::printf("rtcl render: %s (%ux%u, beam tracing, %s depth order, exact pixel coverage, reflection and "
+              "refraction beams to depth %u (refraction linearised, one M_t per beam), candidates by BVH frustum cull, "
+              "point-light shadows by shadow rays through %s, %s): %zu polygons, %zu tile beams of 8x8 px + %zu "
+              "reflected + %zu refracted beams in %u levels, %zu candidates, %zu fragments, %zu pixel pieces, %zu "
+              "shadow rays in %.3f s (clipping kernels %.1f ms, candidate cull %.1f ms)\n",
               o.output.c_str(), bs.width, bs.height, o.beam_order.c_str(), bs.max_depth, bs.accel.c_str(),
-              device.info().name.c_str(), st.polygons, st.tiles, st.reflected_beams, st.levels, st.candidates,
-              st.fragments, st.pixel_pieces, st.shadow_rays, st.render_ms * 1e-3, st.clip_ms);
+              device.info().name.c_str(), st.polygons, st.tiles, st.reflected_beams, st.refracted_beams, st.levels,
+              st.candidates, st.fragments, st.pixel_pieces, st.shadow_rays, st.render_ms * 1e-3, st.clip_ms,
+              st.cull_ms);
 }
 
 // --method selective | wavelet: the image, and its summary line.

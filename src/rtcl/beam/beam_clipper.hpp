@@ -20,17 +20,26 @@ namespace rtcl::beam {
 // visible coverage.
 inline constexpr float device_min_area_fraction = 1e-6f;
 
+// A beam over a limit is cut into quarters while its bounding box is at
+// least this wide (pixels).
+inline constexpr double min_split_px = 1.0 / 64.0;
+
 struct DeviceClipStats {
-  double clip_ms = 0.0;             // device time of the kernel (0 without profiling)
+  double clip_ms = 0.0;             // device time of the kernels (0 without profiling)
   std::size_t fragments = 0;        // convex fragment pieces written
-  std::size_t launches = 0;         // 2 when the fragment buffer had to grow
+  std::size_t launches = 0;         // one per set of beams, plus one per fragment buffer that had to grow
+  std::size_t split_beams = 0;      // quarters clipped again (beams over a limit, cut in four)
 };
 
 // Fragments as the device wrote them, sorted by (beam, seq): the host
-// reference's order. Throws Error naming the beam and the limit when a beam
-// needs more than RTCL_BEAM_MAX_PIECES pieces or a piece more than
-// RTCL_BEAM_PIECE_VERTS vertices, and when the fragments do not fit in the
-// device's memory (after one retry with a buffer of the size counted).
+// reference's order, except for a beam that needed more than
+// RTCL_BEAM_MAX_PIECES pieces or a piece of more than RTCL_BEAM_PIECE_VERTS
+// vertices: it is cut into the four quarters of its bounding box (each with
+// the candidates that meet it, exactly), which are clipped again, and its
+// fragments are theirs, quarter by quarter. Throws Error naming the beam
+// and the limit when a piece below min_split_px still goes over, and when
+// the fragments do not fit in the device's memory (after one retry with a
+// buffer of the size counted).
 std::vector<BeamFragment> clip_beams_device(const Device& device, const std::vector<ScreenPolygon>& polygons,
                                             const BeamSet& beams, DepthOrder order,
                                             DeviceClipStats* stats = nullptr);

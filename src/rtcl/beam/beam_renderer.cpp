@@ -5,12 +5,17 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
+#include <unordered_map>
 #include <utility>
 
 #include "rtcl/accel/accel.hpp"
+#include "rtcl/accel/bvh.hpp"
+#include "rtcl/beam/beam_cull.hpp"
 #include "rtcl/beam/beam_clipper.hpp"
 #include "rtcl/beam/mirror.hpp"
 #include "rtcl/beam/polygon2d.hpp"
+#include "rtcl/beam/refraction.hpp"
 #include "rtcl/beam/screen_space.hpp"
 #include "rtcl/beam/tile_beams.hpp"
 #include "rtcl/error.hpp"
@@ -42,11 +47,17 @@ dvec2 centroid(const Convex& c, double a) {
   return sum / (6.0 * a);
 }
 
-// One world of the beam tree: the scene moved by the product of its
-// mirrors' M_r, its screen polygons polygons[first .. first + count).
+// One world of the beam tree: the scene moved by the product of the
+// transforms of the interfaces above it (M_r of a mirror, M_t of a
+// refracting polygon), clipped to the far side of the last interface
+// (`keep`, in the world's coordinates). Its screen polygons are made on
+// demand: polygon_of maps a triangle to its index in Visible::polygons, or
+// to -1 when it is not seen in this world.
 struct World {
   glm::dmat4 to_virtual{1.0}, to_real{1.0};
-  std::uint32_t first = 0, count = 0;
+  bool clipped = false;
+  glm::dvec4 keep{0.0};
+  std::unordered_map<std::uint32_t, std::int64_t> polygon_of;
 };
 
 struct BeamInfo {
@@ -91,6 +102,114 @@ void rasterise(const Convex& piece, std::uint32_t width, std::uint32_t height, O
     }
 }
 
+// The builder of the beam tree below the viewing beam: worlds, their
+// polygons and the candidates of each beam.
+class Tree {
+ public:
+  Tree(Visible& v, const Geometry& g, const BeamSettings& s) : v_(v), g_(g), s_(s) {}
+
+  // Triangle prim's screen polygon in world w (made on first use), or -1.
+  std::int64_t polygon_in(std::uint32_t w, std::uint32_t prim) {
+    World& wd = v_.worlds[w];
+    auto it = wd.polygon_of.find(prim);
+    if (it != wd.polygon_of.end()) return it->second;
+    ScreenPolygon sp;
+    std::int64_t index = -1;
+    if (screen_polygon(v_.screen, g_, prim, wd.to_virtual, wd.clipped ? &wd.keep : nullptr, keep_margin(), &sp)) {
+      index = std::int64_t(v_.polygons.size());
+      v_.polygons.push_back(std::move(sp));
+    }
+    wd.polygon_of.emplace(prim, index);
+    return index;
+  }
+
+  // The world seen through the fragment of triangle prim in world `parent`:
+  // `bend` maps the new world's real points to the parent's real points on
+  // the straight continuation of its rays (M_r, M_t).
+  std::uint32_t add_world(std::uint32_t parent, std::uint32_t prim, const glm::dmat4& bend) {
+    World child;
+    const World& p = v_.worlds[parent];
+    child.to_virtual = p.to_virtual * bend;
+    child.to_real = glm::inverse(child.to_virtual);
+    // The interface in the parent's (and, fixed by `bend`, the child's)
+    // coordinates; keep its side away from the eye.
+    glm::dvec4 L = glm::transpose(p.to_real) * real_plane(prim);
+    L /= glm::length(glm::dvec3(L));
+    child.clipped = true;
+    child.keep = glm::dot(L, glm::dvec4(v_.screen.frame.origin, 1.0)) > 0.0 ? -L : L;
+    v_.worlds.push_back(std::move(child));
+    return std::uint32_t(v_.worlds.size() - 1);
+  }
+
+  // The plane of triangle prim in the real world, unit normal along (b - a) x (c - a).
+  glm::dvec4 real_plane(std::uint32_t prim) const {
+    const glm::uvec3& t = g_.triangles[prim];
+    return plane_through(dvec3(g_.vertices[t.x]), dvec3(g_.vertices[t.y]), dvec3(g_.vertices[t.z]));
+  }
+
+  // Appends the beam over `section` in world w with its candidates: the
+  // triangles the BVH frustum cull keeps (CandidateCull::bvh) or all of
+  // them (CandidateCull::all), then the exact overlap test.
+  void add(BeamSet& set, const Convex& section, std::uint32_t w) {
+    auto start = std::chrono::steady_clock::now();
+    prims_.clear();
+    if (s_.cull == CandidateCull::bvh) {
+      if (bvh_.empty()) bvh_ = build_binary_bvh(g_);
+      const World& wd = v_.worlds[w];
+      cull(bvh_, beam_frustum(v_.screen, section, wd.to_virtual, wd.clipped ? &wd.keep : nullptr), prims_);
+    } else {
+      for (std::uint32_t t = 0; t < g_.triangles.size(); ++t) prims_.push_back(t);
+    }
+    std::vector<std::uint32_t> polygons;
+    for (std::uint32_t prim : prims_) {
+      std::int64_t i = polygon_in(w, prim);
+      if (i >= 0) polygons.push_back(std::uint32_t(i));
+    }
+    add_beam(set, section, v_.polygons, polygons);
+    v_.stats.cull_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+
+ private:
+  double keep_margin() const { return 1e-9 * v_.screen.near / near_fraction; }
+
+  Visible& v_;
+  const Geometry& g_;
+  const BeamSettings& s_;
+  BuildTree bvh_;
+  std::vector<std::uint32_t> prims_;
+};
+
+// A child beam of a fragment: its world and weight.
+struct Child {
+  std::uint32_t world;
+  dvec3 weight;
+};
+
+// Refraction at a fragment of a transmissive polygon (plane: its real-world
+// plane), decided by the fragment's central ray, from the eye through the
+// centroid of its cross-section: F, the ray tracer's Fresnel reflectance
+// (kernels/render/shade.cl; 1 under total internal reflection), and M_t
+// (none under total internal reflection).
+struct Refraction {
+  double F = 1.0;
+  std::optional<glm::dmat4> bend;
+};
+Refraction refraction_at(const ScreenSpace& screen, const World& world, const ScreenPolygon& polygon,
+                         const glm::dvec4& plane, const dvec2& centre, double ior) {
+  const dvec3 eye = screen.frame.origin;
+  const dvec3 through = unproject(screen, polygon.inv_depth, centre);
+  const dvec3 incident = glm::normalize(glm::dmat3(world.to_real) * (through - eye));
+  double cos_i = -glm::dot(incident, dvec3(plane));
+  const double eta = cos_i > 0.0 ? 1.0 / ior : ior;  // arriving on the normal's side: entering
+  cos_i = std::abs(cos_i);
+  const double sin2_t = eta * eta * (1.0 - cos_i * cos_i);
+  Refraction r;
+  if (!(sin2_t < 1.0)) return r;
+  r.bend = refraction_matrix(plane, incident, eta);
+  if (r.bend) r.F = fresnel_dielectric(cos_i, std::sqrt(1.0 - sin2_t), eta);
+  return r;
+}
+
 // The beam tree, level by level: one device launch per level.
 Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene& flat, const BeamSettings& s,
                        bool primary_only = false) {
@@ -98,9 +217,10 @@ Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene
   const Geometry& g = flat.geometry;
   v.screen = screen_space(camera_frame(scene.camera, s.width, s.height), s.width, s.height, g);
   v.polygons = screen_polygons(v.screen, g);
-  v.worlds.push_back(World{glm::dmat4(1.0), glm::dmat4(1.0), 0, std::uint32_t(v.polygons.size())});
+  v.worlds.emplace_back();
+  for (std::size_t i = 0; i < v.polygons.size(); ++i) v.worlds[0].polygon_of.emplace(v.polygons[i].prim, std::int64_t(i));
+  Tree tree(v, g, s);
   v.background_weight.assign(std::size_t(s.width) * s.height, dvec3(0.0));
-  const double reach = v.screen.near / near_fraction;
   BeamSet level = tile_beams(v.polygons, s.width, s.height);
   std::vector<BeamInfo> info(level.beams.size(), BeamInfo{0, dvec3(1.0), 0});
   v.stats.polygons = v.polygons.size();
@@ -109,7 +229,11 @@ Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene
   for (const Beam& b : level.beams)
     rasterise(cross_section(b), s.width, s.height,
               [&](std::uint32_t px, double a, dvec2) { v.background_weight[px] += a * dvec3(1.0); });
-  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> world_of;  // (parent world, mirror prim)
+  std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> mirror_world;  // (parent world, mirror prim)
+  auto heavy = [&](const dvec3& w) {
+    double m = std::max({w.x, w.y, w.z});
+    return m > 0.0 && m >= double(s.min_weight);
+  };
   while (!level.beams.empty()) {
     ++v.stats.levels;
     v.stats.candidates += level.candidates.size();
@@ -119,48 +243,47 @@ Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene
     v.stats.clip_ms += cs.clip_ms;
     BeamSet next;
     std::vector<BeamInfo> next_info;
-    std::vector<Convex> next_sections;
     for (const BeamFragment& f : frags) {
-      const BeamInfo& bi = info[f.beam];
-      const ScreenPolygon& sp = v.polygons[f.polygon];
+      const BeamInfo bi = info[f.beam];
+      const std::uint32_t prim = v.polygons[f.polygon].prim;
       Convex piece = piece_of(f);
       rasterise(piece, s.width, s.height, [&](std::uint32_t px, double a, dvec2 c) {
         v.pieces.push_back({px, f.polygon, bi.world, a, c, bi.weight});
         v.background_weight[px] -= a * bi.weight;
       });
-      const Material& m = scene.materials[flat.material[sp.prim]];
-      if (primary_only || !m.reflective() || bi.depth >= s.max_depth) continue;
-      dvec3 w = bi.weight * dvec3(m.kr);
-      if (!(std::max({w.x, w.y, w.z}) >= double(s.min_weight)) || !(std::max({w.x, w.y, w.z}) > 0.0)) continue;
-      auto key = std::make_pair(bi.world, sp.prim);
-      auto it = world_of.find(key);
-      if (it == world_of.end()) {
-        const World parent = v.worlds[bi.world];
-        const glm::uvec3& t = g.triangles[sp.prim];
-        auto moved = [&](std::uint32_t i) { return dvec3(parent.to_virtual * glm::dvec4(dvec3(g.vertices[i]), 1.0)); };
-        glm::dvec4 L = plane_through(moved(t.x), moved(t.y), moved(t.z));
-        World child;
-        child.to_virtual = reflection_matrix(L) * parent.to_virtual;
-        child.to_real = glm::inverse(child.to_virtual);
-        // Keep the far side of the mirror from the eye (the mirror maps to itself).
-        glm::dvec4 keep = glm::dot(L, glm::dvec4(v.screen.frame.origin, 1.0)) > 0.0 ? -L : L;
-        std::vector<ScreenPolygon> polys = screen_polygons(v.screen, g, child.to_virtual, &keep, 1e-9 * reach);
-        child.first = std::uint32_t(v.polygons.size());
-        child.count = std::uint32_t(polys.size());
-        v.polygons.insert(v.polygons.end(), polys.begin(), polys.end());
-        it = world_of.emplace(key, std::uint32_t(v.worlds.size())).first;
-        v.worlds.push_back(child);
+      const Material& m = scene.materials[flat.material[prim]];
+      const double area = signed_area(piece.v);  // 0 for a piece collinear in double: no child
+      if (primary_only || bi.depth >= s.max_depth || !(area > 0.0)) continue;
+      // Children with the ray tracer's weights: reflected kr + kt F,
+      // refracted kt (1 - F).
+      std::vector<Child> children;
+      dvec3 reflected = bi.weight * dvec3(m.kr);
+      if (m.transmissive()) {
+        Refraction r = refraction_at(v.screen, v.worlds[bi.world], v.polygons[f.polygon], tree.real_plane(prim),
+                                     centroid(piece, area), double(m.ior));
+        if (!r.bend) ++v.stats.total_internal_reflections;
+        const dvec3 refracted = bi.weight * dvec3(m.kt) * (1.0 - r.F);
+        if (r.bend && heavy(refracted)) {
+          children.push_back({tree.add_world(bi.world, prim, *r.bend), refracted});
+          ++v.stats.refracted_beams;
+        }
+        reflected += bi.weight * dvec3(m.kt) * r.F;
       }
-      next_sections.push_back(piece);
-      next_info.push_back(BeamInfo{it->second, w, bi.depth + 1});
+      if (heavy(reflected)) {
+        auto key = std::make_pair(bi.world, prim);
+        auto it = mirror_world.find(key);
+        if (it == mirror_world.end())
+          it = mirror_world.emplace(key, tree.add_world(bi.world, prim, reflection_matrix(tree.real_plane(prim)))).first;
+        children.push_back({it->second, reflected});
+        ++v.stats.reflected_beams;
+      }
+      for (const Child& c : children) {
+        tree.add(next, piece, c.world);
+        next_info.push_back(BeamInfo{c.world, c.weight, bi.depth + 1});
+        rasterise(piece, s.width, s.height,
+                  [&](std::uint32_t px, double a, dvec2) { v.background_weight[px] += a * c.weight; });
+      }
     }
-    for (std::size_t i = 0; i < next_sections.size(); ++i) {
-      const World& wd = v.worlds[next_info[i].world];
-      add_beam(next, next_sections[i], v.polygons, wd.first, wd.count);
-      rasterise(next_sections[i], s.width, s.height,
-                [&](std::uint32_t px, double a, dvec2) { v.background_weight[px] += a * next_info[i].weight; });
-    }
-    v.stats.reflected_beams += next.beams.size();
     level = std::move(next);
     info = std::move(next_info);
   }
@@ -184,9 +307,9 @@ void check_beam_scene(const Scene& scene) {
     if (mesh.end_transform)
       throw Error(mesh.motion_key + ": a moving object; --method beam traces a static scene (use --method ray)");
   for (const Material& m : scene.materials)
-    if (m.transmissive() || m.glossy())
-      throw Error(scene.source + ": material '" + m.name + "' is " + (m.transmissive() ? "transmissive" : "glossy") +
-                  "; --method beam traces mirror reflection only (use --method ray)");
+    if (m.glossy())
+      throw Error(scene.source + ": material '" + m.name +
+                  "' is glossy; --method beam traces mirror reflection and refraction only (use --method ray)");
 }
 
 std::vector<CoverageEntry> beam_coverage(const Device& device, const Scene& scene, const BeamSettings& settings) {

@@ -34,4 +34,10 @@ std::optional<glm::dmat4> refraction_matrix(const glm::dvec4& plane, const glm::
   return m;
 }
 
+double fresnel_dielectric(double cos_i, double cos_t, double eta) {
+  const double rs = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+  const double rp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
 }  // namespace rtcl::beam

@@ -7,8 +7,9 @@
 //   alpha = (tan theta1 - tan theta2) / sin theta1,
 // i.e. P = M_t P_t with M_t = E + alpha M L^T. Exact for the rays of
 // incidence angle theta1 in the plane of incidence; for the other rays of a
-// beam the error grows with theta1 (tan is linear only near 0). Not used by
-// the beam renderer yet (no refraction beams).
+// beam the error grows with theta1 (tan is linear only near 0). The beam
+// renderer builds one M_t per refracted beam from its central ray
+// (beam_renderer.hpp).
 #pragma once
 
 #include <optional>
@@ -23,5 +24,10 @@ namespace rtcl::beam {
 // None under total internal reflection (eta sin theta1 > 1). Throws Error for
 // a zero normal or direction, a direction in the plane, or eta <= 0.
 std::optional<glm::dmat4> refraction_matrix(const glm::dvec4& plane, const glm::dvec3& incident, double eta);
+
+// Unpolarised Fresnel reflectance of a dielectric interface, eta = n1 / n2,
+// the cosines of the incident and transmitted angles (both > 0): the ray
+// tracer's (kernels/render/shade.cl), in double.
+double fresnel_dielectric(double cos_i, double cos_t, double eta);
 
 }  // namespace rtcl::beam

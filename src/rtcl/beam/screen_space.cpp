@@ -60,38 +60,43 @@ std::vector<dvec3> clip3(const std::vector<dvec3>& in, Dist dist) {
 
 }  // namespace
 
-std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geometry& geometry,
-                                           const glm::dmat4& to_world, const glm::dvec4* keep_plane,
-                                           double keep_margin) {
+bool screen_polygon(const ScreenSpace& screen, const Geometry& geometry, std::uint32_t t, const glm::dmat4& to_world,
+                    const glm::dvec4* keep_plane, double keep_margin, ScreenPolygon* out) {
   const CameraFrame& f = screen.frame;
   const double screen_area = double(screen.width) * screen.height;
   // One pixel of margin: fragments never reach the screen's border by rounding.
   const Convex rect = rectangle(-1.0, -1.0, screen.width + 1.0, screen.height + 1.0);
+  dvec3 v[3];
+  for (int k = 0; k < 3; ++k) v[k] = dvec3(to_world * glm::dvec4(dvec3(geometry.vertices[geometry.triangles[t][k]]), 1.0));
+  dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
+  double k = glm::dot(n, v[0] - f.origin);
+  if (!(std::abs(k) > 0.0)) return false;  // zero area, or its plane holds the eye: seen edge-on
+  // Near plane s >= near, in world space before the divide.
+  std::vector<dvec3> clipped =
+      clip3({v[0], v[1], v[2]}, [&](const dvec3& p) { return glm::dot(p - f.origin, screen.forward) - screen.near; });
+  if (keep_plane)
+    clipped = clip3(clipped, [&](const dvec3& p) { return glm::dot(*keep_plane, glm::dvec4(p, 1.0)) - keep_margin; });
+  if (clipped.size() < 3) return false;
+  std::vector<dvec2> projected;
+  for (const dvec3& p : clipped) projected.push_back(project(screen, p));
+  // Clipping leaves near-copies of a vertex (a spike, reflex by rounding)
+  // where a plane passes through it: merged at 1e-9 of the screen's size.
+  Convex c = make_strictly_convex(intersect(make_convex(projected), rect), 1e-9 * (screen.width + screen.height));
+  if (c.v.size() < 3 || signed_area(c.v) < 1e-12 * screen_area) return false;
+  out->v = std::move(c.v);
+  out->inv_depth = dvec3(glm::dot(n, f.du), glm::dot(n, f.dv), glm::dot(n, f.corner)) / k;
+  out->prim = t;
+  return true;
+}
+
+std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geometry& geometry,
+                                           const glm::dmat4& to_world, const glm::dvec4* keep_plane,
+                                           double keep_margin) {
   std::vector<ScreenPolygon> out;
-  for (std::size_t t = 0; t < geometry.triangles.size(); ++t) {
-    dvec3 v[3];
-    for (int k = 0; k < 3; ++k) v[k] = dvec3(to_world * glm::dvec4(dvec3(geometry.vertices[geometry.triangles[t][k]]), 1.0));
-    dvec3 n = glm::cross(v[1] - v[0], v[2] - v[0]);
-    double k = glm::dot(n, v[0] - f.origin);
-    if (!(std::abs(k) > 0.0)) continue;  // zero area, or its plane holds the eye: seen edge-on
-    // Near plane s >= near, in world space before the divide.
-    std::vector<dvec3> clipped =
-        clip3({v[0], v[1], v[2]}, [&](const dvec3& p) { return glm::dot(p - f.origin, screen.forward) - screen.near; });
-    if (keep_plane)
-      clipped = clip3(clipped, [&](const dvec3& p) { return glm::dot(*keep_plane, glm::dvec4(p, 1.0)) - keep_margin; });
-    if (clipped.size() < 3) continue;
-    std::vector<dvec2> projected;
-    for (const dvec3& p : clipped) projected.push_back(project(screen, p));
-    // Clipping leaves near-copies of a vertex (a spike, reflex by rounding)
-    // where a plane passes through it: merged at 1e-9 of the screen's size.
-    Convex c = make_strictly_convex(intersect(make_convex(projected), rect), 1e-9 * (screen.width + screen.height));
-    if (c.v.size() < 3 || signed_area(c.v) < 1e-12 * screen_area) continue;
-    ScreenPolygon sp;
-    sp.v = std::move(c.v);
-    sp.inv_depth = dvec3(glm::dot(n, f.du), glm::dot(n, f.dv), glm::dot(n, f.corner)) / k;
-    sp.prim = static_cast<std::uint32_t>(t);
-    out.push_back(std::move(sp));
-  }
+  ScreenPolygon sp;
+  for (std::size_t t = 0; t < geometry.triangles.size(); ++t)
+    if (screen_polygon(screen, geometry, std::uint32_t(t), to_world, keep_plane, keep_margin, &sp))
+      out.push_back(std::move(sp));
   return out;
 }
 

@@ -44,13 +44,17 @@ glm::dvec3 unproject(const ScreenSpace& screen, const glm::dvec3& inv_depth, con
 // 1e-12 of the screen are left out. Spheres are not polygons: the caller
 // refuses them (render/beam_renderer.hpp).
 //
-// A reflected beam's world (mirror.hpp): every vertex is first moved by
-// `to_world` (the product of the beam tree's mirror transforms), and the
-// triangles are clipped, like by the near plane, to keep_plane . (p, 1) >=
-// keep_margin (the far side of the last mirror; the margin, in scene units,
-// drops the mirror itself and polygons in its plane).
+// A reflected or refracted beam's world (mirror.hpp, refraction.hpp): every
+// vertex is first moved by `to_world` (the product of the beam tree's M_r
+// and M_t), and the triangles are clipped, like by the near plane, to
+// keep_plane . (p, 1) >= keep_margin (the far side of the last interface;
+// the margin, in scene units, drops the interface itself and polygons in
+// its plane).
 std::vector<ScreenPolygon> screen_polygons(const ScreenSpace& screen, const Geometry& geometry,
                                            const glm::dmat4& to_world = glm::dmat4(1.0),
                                            const glm::dvec4* keep_plane = nullptr, double keep_margin = 0.0);
+// The same for triangle t alone: false when it is left out.
+bool screen_polygon(const ScreenSpace& screen, const Geometry& geometry, std::uint32_t t, const glm::dmat4& to_world,
+                    const glm::dvec4* keep_plane, double keep_margin, ScreenPolygon* out);
 
 }  // namespace rtcl::beam

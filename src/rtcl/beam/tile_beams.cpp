@@ -12,7 +12,7 @@ namespace {
 
 struct Candidate {
   double key;
-  std::uint32_t polygon;
+  std::uint32_t prim, polygon;
 };
 
 struct Box2 {
@@ -41,7 +41,7 @@ void push_beam(BeamSet& set, const Convex& section, std::vector<Candidate>& list
     throw Error("beam: a beam's cross-section has " + std::to_string(section.v.size()) + " vertices (3 .. " +
                 std::to_string(RTCL_BEAM_PIECE_VERTS) + ")");
   std::sort(list.begin(), list.end(), [](const Candidate& a, const Candidate& b) {
-    return a.key != b.key ? a.key > b.key : a.polygon < b.polygon;
+    return a.key != b.key ? a.key > b.key : a.prim < b.prim;
   });
   Beam b{};
   Box2 box = box_of(section.v);
@@ -60,16 +60,16 @@ void push_beam(BeamSet& set, const Convex& section, std::vector<Candidate>& list
 
 }  // namespace
 
-void add_beam(BeamSet& set, const Convex& section, const std::vector<ScreenPolygon>& polygons, std::uint32_t first,
-              std::uint32_t count) {
+void add_beam(BeamSet& set, const Convex& section, const std::vector<ScreenPolygon>& polygons,
+              std::span<const std::uint32_t> candidates) {
   const double min_area = beam_min_area_fraction * signed_area(section.v);
   Box2 box = box_of(section.v);
   std::vector<Candidate> list;
-  for (std::uint32_t p = first; p < first + count; ++p) {
+  for (std::uint32_t p : candidates) {
     Box2 pb = box_of(polygons[p].v);
     if (pb.hi.x < box.lo.x || box.hi.x < pb.lo.x || pb.hi.y < box.lo.y || box.hi.y < pb.lo.y) continue;
     double key;
-    if (candidate(polygons[p], section, min_area, &key)) list.push_back({key, p});
+    if (candidate(polygons[p], section, min_area, &key)) list.push_back({key, polygons[p].prim, p});
   }
   push_beam(set, section, list);
 }
@@ -95,7 +95,7 @@ BeamSet tile_beams(const std::vector<ScreenPolygon>& polygons, std::uint32_t wid
         Convex section = section_of(tx, ty);
         double key;
         if (candidate(polygons[p], section, beam_min_area_fraction * signed_area(section.v), &key))
-          lists[std::size_t(ty) * set.columns + tx].push_back({key, p});
+          lists[std::size_t(ty) * set.columns + tx].push_back({key, polygons[p].prim, p});
       }
   }
   for (std::uint32_t ty = 0; ty < set.rows; ++ty)

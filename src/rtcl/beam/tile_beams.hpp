@@ -1,14 +1,18 @@
 // Beams and their candidate polygons in walking order. The viewing beam is
 // split into tile beams (prisms over tile x tile pixel squares); a reflected
-// beam is the prism over a mirror fragment. Candidates are culled in screen
-// space: a polygon is a candidate of a beam when its projection meets the
-// beam's cross-section with positive area (exact, in double; not a BVH
-// frustum test). Walking order: descending key, the largest inverse depth
+// or refracted beam is the prism over a fragment of a mirror or a
+// transmissive polygon. A polygon is a candidate of a beam when its
+// projection meets the beam's cross-section with positive area (exact, in
+// double); tile beams test the polygons whose bounding box meets the tile,
+// the other beams those the BVH frustum cull leaves (beam_cull.hpp).
+// Walking order: descending key, the largest inverse depth
 // 1/s of the polygon's part inside the beam (its nearest point there), ties
-// by polygon index.
+// by triangle id (a beam's candidates all come from one world, so the order
+// does not depend on when their screen polygons were made).
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "rtcl/beam/beam_layouts.hpp"
@@ -24,11 +28,12 @@ struct BeamSet {
 };
 
 // Appends the beam over `cross_section` (convex, counter-clockwise, 3 ..
-// RTCL_BEAM_PIECE_VERTS vertices, pixels) with candidates among
-// polygons[first .. first + count). Throws Error when the cross-section has
-// too many vertices.
+// RTCL_BEAM_PIECE_VERTS vertices, pixels) with its candidates among
+// polygons[i], i in `candidates` (those meeting the cross-section with
+// positive area, exact). Throws Error when the cross-section has too many
+// vertices.
 void add_beam(BeamSet& set, const Convex& cross_section, const std::vector<ScreenPolygon>& polygons,
-              std::uint32_t first, std::uint32_t count);
+              std::span<const std::uint32_t> candidates);
 
 // The tile beams of a width x height screen over all polygons, row by row;
 // the last column and row may be narrower.
