@@ -4,6 +4,9 @@
 #ifndef RTCL_SHARED_OCTREE_H
 #define RTCL_SHARED_OCTREE_H
 
+/* The leaf tests' triangle arithmetic inlined into the traversal
+ * (shared/triangle.h). */
+#define RTCL_INLINE_TRIANGLE_LANES
 #include "shared/trace.h"
 
 /* Clips one axis of the ray to the slab [lower, upper] (conservatively
