@@ -98,7 +98,7 @@ RTCL_LANES_INLINE int8 rtcl_watertight_hit8(const Watertight8* w, float8 sz, flo
 /* How intersect_triangle_lanes is compiled: a plain inline function, which
  * PoCL keeps as a call (its float8 arguments passed through memory), or
  * always inlined where the kernel defines RTCL_INLINE_TRIANGLE_LANES (the
- * octrees, kernels/shared/octree.h: measured 8% faster on the bunny's
+ * octrees, kernels/shared/octree.h: measured 7-8% faster on the bunny's
  * primary rays, README "Octrees"). */
 #ifdef RTCL_INLINE_TRIANGLE_LANES
 #define RTCL_TRIANGLE_LANES_INLINE RTCL_LANES_INLINE
