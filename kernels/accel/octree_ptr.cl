@@ -83,12 +83,16 @@ __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* 
   const int root = header->root;
   if (root == RTCL_CHILD_EMPTY) return;
   float ta = s->tmin, tb = s->tmax;
-  int step_x, step_y, step_z;
-  if (!octree_clip_axis(s->ox, s->dx, s->ix, header->lower[0], header->upper[0], &ta, &tb, &step_x) ||
-      !octree_clip_axis(s->oy, s->dy, s->iy, header->lower[1], header->upper[1], &ta, &tb, &step_y) ||
-      !octree_clip_axis(s->oz, s->dz, s->iz, header->lower[2], header->upper[2], &ta, &tb, &step_z))
+  int step_x = octree_axis_step(s->dx, s->ix), step_y = octree_axis_step(s->dy, s->iy),
+      step_z = octree_axis_step(s->dz, s->iz);
+  /* the occupied boxes lie in the root box (widened as every cell is): where
+   * they narrow [ta, tb], the clip to the root box adds nothing */
+  if (!rtcl_slabs_defined(s) &&
+      (!octree_clip_axis(s->ox, s->dx, s->ix, header->lower[0], header->upper[0], &ta, &tb, &step_x) ||
+       !octree_clip_axis(s->oy, s->dy, s->iy, header->lower[1], header->upper[1], &ta, &tb, &step_y) ||
+       !octree_clip_axis(s->oz, s->dz, s->iz, header->lower[2], header->upper[2], &ta, &tb, &step_z) ||
+       !(ta <= tb)))
     return;
-  if (!(ta <= tb)) return;
   const int root_live = octree_ptr_occupied(&header->occupied_bounds[0][0], s, &ta, &tb);
   if (root_live == 0) return;
   const float4 o = (float4)(s->ox, s->oy, s->oz, 0.0f), inv = (float4)(s->ix, s->iy, s->iz, 0.0f);

@@ -4,17 +4,25 @@
 #ifndef RTCL_SHARED_OCTREE_H
 #define RTCL_SHARED_OCTREE_H
 
+/* The leaf tests' triangle arithmetic inlined into the traversal
+ * (shared/triangle.h). */
+#define RTCL_INLINE_TRIANGLE_LANES
 #include "shared/trace.h"
+
+/* The ray's step along one axis: the direction's sign, 0 when it does not
+ * move along the axis (zero component, or a reciprocal that overflows). */
+inline int octree_axis_step(float d, float inv) {
+  return (d == 0.0f || !rtcl_is_finite(inv)) ? 0 : (d > 0.0f ? 1 : -1);
+}
 
 /* Clips one axis of the ray to the slab [lower, upper] (conservatively
  * widened, as the grid's: entering a cell too early costs a test, too late
- * a miss) and sets its step: the direction's sign, 0 when the ray does not
- * move along the axis (zero component, or a reciprocal that overflows);
- * such an axis limits nothing when the origin lies within the slab.
+ * a miss) and sets its step (octree_axis_step); an axis the ray does not
+ * move along limits nothing when the origin lies within the slab.
  * Returns 0 when the ray misses the slab. */
 inline int octree_clip_axis(float o, float d, float inv, float lower, float upper, float* t0, float* t1,
                             int* step) {
-  *step = (d == 0.0f || !rtcl_is_finite(inv)) ? 0 : (d > 0.0f ? 1 : -1);
+  *step = octree_axis_step(d, inv);
   if (*step == 0) return o >= lower && o <= upper;
   float tn = ((*step > 0 ? lower : upper) - o) * inv;
   float tf = ((*step > 0 ? upper : lower) - o) * inv;
