@@ -248,6 +248,19 @@ typedef struct KdNode {
 #define RTCL_KD_INNER(axis, above) ((rtcl_u32)(axis) | ((rtcl_u32)(above) << 2))
 #define RTCL_KD_LEAF_NODE(first) (RTCL_KD_LEAF | ((rtcl_u32)(first) << 2))
 
+/* The single-ray traversal's nodes (kernels/accel/kdtree.cl; built by
+ * src/rtcl/accel/kdtree_fused.cpp from the KdNode array) are Bvh8Node
+ * records, each three levels of the kd-tree: lane c = 4 b0 + 2 b1 + b2 is
+ * the cell below (b = 0) or above (b = 1) the plane of each level on its
+ * path; its bounds are the cell's box shrunk to what it holds (a leaf: its
+ * primitives clipped to the cell; a deeper subtree: the union of its
+ * cells), and child[c] >= 0 is the fused node of the subtree at level 3,
+ * < 0 the leaf ~child[c] of the KdNode array, RTCL_KD_NO_CELL nothing (an
+ * empty leaf, a cell a shallower leaf leaves free; bounds lower = +inf,
+ * upper = -inf). A leaf above level 3 takes the cell on its side of every
+ * level below it (the leaf of a one-leaf tree: lane 7). */
+#define RTCL_KD_NO_CELL 0x7fffffff
+
 /* The tree's root box [lower, upper] (closed, float), which contains every
  * stored primitive; traversal clips the ray to it; and the rows' stride of
  * the reference lanes (KdNode). 48 bytes; element [3] of each row is
