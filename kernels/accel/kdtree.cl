@@ -1,6 +1,6 @@
 /* BSP and kd-tree traversal, one ray per work-item: the lecture's
  * RayTreeIntersect(Ray, Node, min, max) (空间二分树, "Traversal in BSP
- * Tree") with an explicit stack in place of the recursion, three tree
+ * Tree") with an explicit stack in place of the recursion, several tree
  * levels per step. Both structures (src/rtcl/accel/bsp.cpp: midpoint
  * splits; kdtree.cpp: SAH splits) build the same nodes (KdNode,
  * kernels/shared/layouts.h), so this one file is the kernel of both:
@@ -11,12 +11,13 @@
  * child's is its parent's cut at the plane's dist = (split - o) / d (near
  * over [min, dist], far over [dist, max]). That is the ray's interval
  * inside the child's box, whose faces are the planes of its path and the
- * root box. Here a step takes three levels at once: the host fuses each
- * three-level subtree into a Bvh8Node (src/rtcl/accel/kdtree_fused.cpp;
- * lane c the cell of path c, its box shrunk to what the cell holds, which
- * only narrows the interval to where a hit can lie), and the eight cells'
- * [min, max] are the slab test of their boxes in float8 lanes against
- * [tmin, t_best] (intersect_boxes8, shared/box.h). The cells entered are
+ * root box. Here a step takes several levels at once: the host cuts the
+ * tree into subtrees of up to eight cells each (kd nodes whose cells tile
+ * the subtree root's cell), stored as a Bvh8Node (src/rtcl/accel/
+ * kdtree_fused.cpp; a lane's box is its cell shrunk to what the cell
+ * holds, which only narrows the interval to where a hit can lie), and the
+ * eight cells' [min, max] are the slab test of their boxes in float8 lanes
+ * against [tmin, t_best] (intersect_boxes8, shared/box.h). The cells entered are
  * pushed sorted by min, the nearest on top, so cells are visited front to
  * back as the recursion visits near before far.
  * Special cases, by the slab arithmetic of shared/box.h:
@@ -47,10 +48,11 @@
  * Stack bound (RTCL_KD_CELL_STACK, compile-time, kKdCellStack of
  * src/rtcl/accel/kdtree_fused.hpp): a step pushes at most eight cells and
  * the walk pops one to go on, so each fused ancestor of the node walked
- * keeps at most 7 entries; a tree of depth D has at most ceil(D / 3) fused
- * levels, and the host refuses trees deeper than kKdMaxDepth
+ * keeps at most 7 entries; a fused node below the root spans at least two
+ * kd levels, so a tree of depth D has at most max(1, D) fused levels, and
+ * the host refuses trees deeper than kKdMaxDepth
  * (src/rtcl/accel/kdtree_nodes.cpp), so the stack holds at most
- * 7 ceil(kKdMaxDepth / 3) + 1 entries. */
+ * 7 kKdMaxDepth + 1 entries. */
 #include "shared/bvh8_stack.h"
 #include "shared/trace.h"
 

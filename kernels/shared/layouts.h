@@ -250,15 +250,13 @@ typedef struct KdNode {
 
 /* The single-ray traversal's nodes (kernels/accel/kdtree.cl; built by
  * src/rtcl/accel/kdtree_fused.cpp from the KdNode array) are Bvh8Node
- * records, each three levels of the kd-tree: lane c = 4 b0 + 2 b1 + b2 is
- * the cell below (b = 0) or above (b = 1) the plane of each level on its
- * path; its bounds are the cell's box shrunk to what it holds (a leaf: its
- * primitives clipped to the cell; a deeper subtree: the union of its
- * cells), and child[c] >= 0 is the fused node of the subtree at level 3,
- * < 0 the leaf ~child[c] of the KdNode array, RTCL_KD_NO_CELL nothing (an
- * empty leaf, a cell a shallower leaf leaves free; bounds lower = +inf,
- * upper = -inf). A leaf above level 3 takes the cell on its side of every
- * level below it (the leaf of a one-leaf tree: lane 7). */
+ * records, each a subtree of the kd-tree cut off at up to eight cells
+ * (kd nodes whose cells tile the subtree root's cell, less empty leaves):
+ * lane k's bounds are its cell's box shrunk to what it holds (a leaf: its
+ * primitives clipped to the cell; an inner kd node: the union of its fused
+ * node's lanes), and child[k] >= 0 is the fused node of an inner kd node,
+ * < 0 the leaf ~child[k] of the KdNode array, RTCL_KD_NO_CELL an unused
+ * lane (bounds lower = +inf, upper = -inf). */
 #define RTCL_KD_NO_CELL 0x7fffffff
 
 /* The tree's root box [lower, upper] (closed, float), which contains every

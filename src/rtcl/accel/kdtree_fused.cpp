@@ -11,82 +11,78 @@ namespace rtcl {
 namespace {
 
 bool is_leaf(const KdNode& n) { return (n.flags & 3u) == RTCL_KD_LEAF; }
+bool is_empty_leaf(const KdNode& n) { return is_leaf(n) && n.data == 0; }
 
 struct Fuser {
   const std::vector<KdNode>& nodes;
   const std::function<KdBox(std::size_t leaf, const KdBox& cell)>& leaf_bounds;
   std::vector<Bvh8Node> out;
 
-  static KdBox cell_box(const Bvh8Node& f, int cell) {
-    KdBox b;
-    for (int a = 0; a < 3; ++a) {
-      b.lower[a] = f.bounds[a][cell];
-      b.upper[a] = f.bounds[3 + a][cell];
-    }
-    return b;
+  static double half_area(const KdBox& b) {
+    const double x = b.upper[0] - b.lower[0], y = b.upper[1] - b.lower[1], z = b.upper[2] - b.lower[2];
+    return x * y + y * z + z * x;
   }
-  static void set_cell_box(Bvh8Node& f, int cell, const KdBox& b) {
+  static void set_lane_box(Bvh8Node& f, int lane, const KdBox& b) {
     for (int a = 0; a < 3; ++a) {
-      f.bounds[a][cell] = b.lower[a];
-      f.bounds[3 + a][cell] = b.upper[a];
+      f.bounds[a][lane] = b.lower[a];
+      f.bounds[3 + a][lane] = b.upper[a];
     }
   }
 
   // Emits the fused node of the kd subtree at nodes[root], whose cell is
-  // `box`; returns its index and sets *bounds to the union of its cells'.
+  // `box`; returns its index and sets *bounds to the union of its lanes'.
+  // The lanes: starting from the root, the frontier node with the largest
+  // cell (surface area) is replaced by its children while that keeps at
+  // most eight lanes; empty leaves take no lane.
   rtcl_i32 emit(std::size_t root, const KdBox& box, KdBox* bounds) {
     const std::size_t index = out.size();
     out.emplace_back();
+    std::vector<std::pair<std::size_t, KdBox>> lanes{{root, box}};
+    for (;;) {
+      int widest = -1;
+      double widest_area = -1.0;
+      for (std::size_t k = 0; k < lanes.size(); ++k) {
+        const auto& [n, cell] = lanes[k];
+        if (is_leaf(nodes[n])) continue;
+        const double area = half_area(cell);
+        if (area > widest_area) widest = static_cast<int>(k), widest_area = area;
+      }
+      if (widest < 0) break;
+      const auto [n, cell] = lanes[static_cast<std::size_t>(widest)];
+      const KdNode& node = nodes[n];
+      const rtcl_u32 axis = node.flags & 3u;
+      const float split = std::bit_cast<float>(node.data);
+      KdBox below = cell, above = cell;
+      below.upper[axis] = split;
+      above.lower[axis] = split;
+      std::vector<std::pair<std::size_t, KdBox>> children;
+      for (const auto& child : {std::pair{n + 1, below}, std::pair{std::size_t(node.flags >> 2), above}})
+        if (!is_empty_leaf(nodes[child.first])) children.push_back(child);
+      if (lanes.size() - 1 + children.size() > 8) break;
+      lanes.erase(lanes.begin() + widest);
+      lanes.insert(lanes.end(), children.begin(), children.end());
+    }
     Bvh8Node f{};
     for (int k = 0; k < 8; ++k) {
-      for (int a = 0; a < 3; ++a) {
-        f.bounds[a][k] = std::numeric_limits<float>::infinity();
-        f.bounds[3 + a][k] = -std::numeric_limits<float>::infinity();
-      }
+      set_lane_box(f, k, KdBox::empty());
       f.child[k] = RTCL_KD_NO_CELL;
     }
-    std::vector<std::pair<int, std::size_t>> deeper;  // (cell, kd inner node at level 3)
-    place(f, root, 0, 0, 1, box, deeper);
-    for (const auto& [cell, node] : deeper) {
-      KdBox b = cell_box(f, cell), tight;
-      f.child[cell] = emit(node, b, &tight);
-      set_cell_box(f, cell, tight);
-    }
     *bounds = KdBox::empty();
-    for (int k = 0; k < 8; ++k) bounds->grow(cell_box(f, k));
+    for (std::size_t k = 0; k < lanes.size(); ++k) {
+      const auto& [n, cell] = lanes[k];
+      if (is_empty_leaf(nodes[n])) continue;
+      KdBox lane_box;
+      if (is_leaf(nodes[n])) {
+        lane_box = leaf_bounds(n, cell);
+        f.child[k] = ~static_cast<rtcl_i32>(n);
+      } else {
+        f.child[k] = emit(n, cell, &lane_box);
+      }
+      set_lane_box(f, static_cast<int>(k), lane_box);
+      bounds->grow(lane_box);
+    }
     out[index] = f;
     return static_cast<rtcl_i32>(index);
-  }
-
-  // Fills the cells [cell, cell + 2^(3 - level)) from kd node n, whose kd
-  // cell is `box`. A leaf above level 3 takes the cell on its side `side`
-  // of every level below it (the others stay empty).
-  void place(Bvh8Node& f, std::size_t n, int level, int cell, int side, const KdBox& box,
-             std::vector<std::pair<int, std::size_t>>& deeper) {
-    const int half = level < 3 ? 1 << (2 - level) : 0;
-    const KdNode& node = nodes[n];
-    if (level == 3 || is_leaf(node)) {
-      if (level < 3) {
-        place(f, n, level + 1, cell + side * half, side, box, deeper);
-        return;
-      }
-      if (is_leaf(node) && node.data == 0) return;
-      if (is_leaf(node)) {
-        set_cell_box(f, cell, leaf_bounds(n, box));
-        f.child[cell] = ~static_cast<rtcl_i32>(n);
-      } else {
-        set_cell_box(f, cell, box);
-        deeper.emplace_back(cell, n);
-      }
-      return;
-    }
-    const rtcl_u32 axis = node.flags & 3u;
-    const float split = std::bit_cast<float>(node.data);
-    KdBox below = box, above = box;
-    below.upper[axis] = split;
-    above.lower[axis] = split;
-    place(f, n + 1, level + 1, cell, 0, below, deeper);
-    place(f, node.flags >> 2, level + 1, cell + half, 1, above, deeper);
   }
 };
 

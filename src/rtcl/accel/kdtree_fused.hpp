@@ -1,8 +1,8 @@
 // The single-ray traversal's nodes (Bvh8Node records, kernels/shared/
-// layouts.h, after KdNode): three levels of a flattened BSP / kd-tree
-// (KdNode array) per node, the eight cells of the three levels in its
-// lanes, so that one step of kernels/accel/kdtree.cl finds the ray's
-// [min, max] in eight cells at once (a float8 slab test of their boxes).
+// layouts.h, after KdNode): a flattened BSP / kd-tree (KdNode array) cut
+// into subtrees of up to eight cells, the cells in a node's lanes, so that
+// one step of kernels/accel/kdtree.cl finds the ray's [min, max] in eight
+// cells at once (a float8 slab test of their boxes).
 #pragma once
 
 #include <algorithm>
@@ -15,14 +15,15 @@
 
 namespace rtcl {
 
-// The traversal stack of the fused nodes (-DRTCL_KD_CELL_STACK). A fused
-// node at fused depth f (the root at 1) holds kd depths 3 (f - 1) ..
-// 3 f - 1, so a tree of depth D <= kKdMaxDepth has fused depth F <=
-// max(1, ceil(D / 3)). A step pushes at most the eight cells the ray
-// enters and the walk then pops one of them, so while a node is walked each
-// of its f - 1 fused ancestors keeps at most 7 entries on the stack, and
-// after its own pushes the stack holds at most 7 (f - 1) + 8 = 7 f + 1.
-constexpr int kKdCellStack = 7 * ((kKdMaxDepth + 2) / 3) + 1;
+// The traversal stack of the fused nodes (-DRTCL_KD_CELL_STACK). Every
+// fused node below the root starts at an inner kd node and takes at least
+// its two children's levels, so a tree of depth D <= kKdMaxDepth has at
+// most max(1, D) fused levels. A step pushes at most the eight cells the
+// ray enters and the walk then pops one of them, so while a node at fused
+// depth f is walked each of its f - 1 fused ancestors keeps at most 7
+// entries on the stack, and after its own pushes the stack holds at most
+// 7 (f - 1) + 8 = 7 f + 1.
+constexpr int kKdCellStack = 7 * kKdMaxDepth + 1;
 
 // A float box; empty() has lower +inf, upper -inf (a cell no ray enters).
 struct KdBox {
