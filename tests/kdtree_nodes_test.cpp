@@ -14,8 +14,10 @@ namespace {
 
 // A chain of kKdMaxDepth inner nodes splitting x at 1 - k / 65 (each inside
 // the one before): a ray along +x from x < 0 crosses every plane, so every
-// node pushes its far child and the stack fills to exactly kKdMaxDepth. All
-// leaves list all primitives, so every leaf answers as brute force does.
+// node pushes its far child and the packet walk's stack fills to exactly
+// kKdMaxDepth (the single-ray walk's fused nodes hold seven of the chain's
+// leaves and its next node each, and push them all). All leaves list all
+// primitives, so every leaf answers as brute force does.
 TEST(KdNodes, AChainOfTheDeepestDepthFillsTheStackExactly) {
   Geometry g = random_soup(40, 12);
   KdPrimitives prims = kd_primitives(g, "kd chain", 0);
