@@ -1,36 +1,37 @@
 /* BSP and kd-tree traversal, one ray per work-item: the lecture's
  * RayTreeIntersect(Ray, Node, min, max) (空间二分树, "Traversal in BSP
- * Tree") with an explicit stack in place of the recursion. Both structures
- * (src/rtcl/accel/bsp.cpp: midpoint splits; kdtree.cpp: SAH splits) build
- * the same nodes (KdNode, kernels/shared/layouts.h), so this one file is
- * the kernel of both: trace_closest_kdtree / trace_any_kdtree.
+ * Tree") with an explicit stack in place of the recursion, several tree
+ * levels per step. Both structures (src/rtcl/accel/bsp.cpp: midpoint
+ * splits; kdtree.cpp: SAH splits) build the same nodes (KdNode,
+ * kernels/shared/layouts.h), so this one file is the kernel of both:
+ * trace_closest_kdtree / trace_any_kdtree.
  *
- * [min, max] starts as the ray's interval [tmin, tmax] clipped to the root
- * box (min < 0 when the origin is inside and tmin < 0). At an inner node
- * with split plane x[axis] = split, dist = (split - o[axis]) / d[axis] is
- * the signed distance along the ray to the plane; near is the child whose
- * half-space holds the origin, far the other one. As in the lecture:
- *   dist > max or dist < 0: the whole interval is on the near side;
- *   dist < min:             the whole interval is on the far side;
- *   otherwise:              near over [min, dist], then far over [dist, max].
- * Special cases:
- *   - a zero (or flushed) direction component: the reciprocal is ±inf, so
- *     dist = ±inf and the ray stays on the near side; the origin decides
- *     the side (below when o < split, above when o > split);
- *   - an origin on the plane (o == split): near is the side the ray comes
- *     from (below when d > 0), so dist = 0 sends t > 0 to the far side;
- *   - a ray lying in the plane (o == split and d == 0, dist = 0 * inf =
- *     NaN): both children, each over the whole interval (a primitive that
- *     touches the plane from one side may be listed on that side only);
- *   - dist exactly at min or max: both children (one of them over an empty
- *     or one-point interval).
- * Where the interval reaches both children and one of them is an empty
- * leaf (the SAH's cut-off empty space), the walk goes on with the other
- * over its part of the interval, pushing nothing.
- * The comparisons are conservative: the plane counts as inside the interval
- * when it is within RTCL_SLAB_WIDEN (relative) of it, which covers the
- * rounding of dist and of the interval ends; the intervals themselves are
- * split at the computed dist.
+ * The recursion gives each node the ray's interval [min, max] inside the
+ * node's cell: the root's is [tmin, tmax] clipped to the root box, and a
+ * child's is its parent's cut at the plane's dist = (split - o) / d (near
+ * over [min, dist], far over [dist, max]). That is the ray's interval
+ * inside the child's box, whose faces are the planes of its path and the
+ * root box. Here a step takes several levels at once: the host cuts the
+ * tree into subtrees of up to eight cells each (kd nodes whose cells tile
+ * the subtree root's cell), stored as a Bvh8Node (src/rtcl/accel/
+ * kdtree_fused.cpp; a lane's box is its cell shrunk to what the cell
+ * holds, which only narrows the interval to where a hit can lie), and the
+ * eight cells' [min, max] are the slab test of their boxes in float8 lanes
+ * against [tmin, t_best] (intersect_boxes8, shared/box.h). The cells entered are
+ * pushed sorted by min, the nearest on top, so cells are visited front to
+ * back as the recursion visits near before far.
+ * Special cases, by the slab arithmetic of shared/box.h:
+ *   - a zero direction component: the reciprocal is ±inf, the distances to
+ *     a box's faces on that axis ±inf, so the origin decides (its side of
+ *     every plane on that axis for the whole interval);
+ *   - an origin on a plane, a ray lying in a plane (0 * inf = NaN, which
+ *     the fmin/fmax chain drops): the closed boxes on both sides are
+ *     entered; dist exactly at min or max: both cells;
+ *   - the interval is widened by RTCL_SLAB_WIDEN (relative), which covers
+ *     the rounding of the distances and of the hit's t. The fast level
+ *     (-cl-fast-relaxed-math) tests the slabs of zero components by the
+ *     origin alone (kd_enter_cells8).
+ * Empty leaves (the SAH's cut-off empty space) are no cell at all.
  *
  * Leaves: the triangles are tested from the reference lanes (KdNode) in
  * contiguous runs of up to eight (intersect_triangle_run: float8 loads, no
@@ -39,40 +40,25 @@
  * brute force, so the same t bit for bit. The closest hit so far stays a
  * candidate even when it lies beyond the leaf's interval (a primitive
  * extending into later leaves is then not closer when met again). Early
- * exit: a subtree on the stack is skipped when the candidate lies before
- * its interval, t_best <= its min less a conservative margin; the walk ends
- * when no subtree is left. A far child's min is the plane's dist, which is
- * the max of the near side's interval, so this is the lecture's exit once
- * the hit lies inside the current interval; a ray lying in a plane pushes
- * its far child over the same interval as the near one, and that subtree
- * is still visited. The margin, KD_EXIT_MARGIN relative, covers the
- * rounding of dist and of the hit's t: a primitive ending exactly on a
- * plane is listed on its side only, and one beyond the plane hit within
- * rounding of dist is still found. Any hit ends at the first hit.
+ * exit: a cell is neither entered nor, when popped, visited once its min
+ * lies beyond the closest hit; the walk ends when no cell is left (the
+ * lecture's exit once the hit lies inside the current interval). Any hit
+ * ends at the first hit.
  *
- * Stack bound (RTCL_KD_STACK, compile-time): an entry is pushed only at an
- * inner node that sends the ray to both children, and holds that node's far
- * child. The entries on the stack are far children of distinct ancestors of
- * the current node (an entry is popped before any node outside its parent's
- * subtree is visited), one per ancestor depth, so a walk that reaches a
- * node at depth k holds at most k entries, and pushes at most depth(tree)
- * in all. The host refuses trees deeper than RTCL_KD_STACK
- * (src/rtcl/accel/kdtree_nodes.cpp, kKdMaxDepth). */
-#include "shared/kdtree.h"
+ * Stack bound (RTCL_KD_CELL_STACK, compile-time, kKdCellStack of
+ * src/rtcl/accel/kdtree_fused.hpp): a step pushes at most eight cells and
+ * the walk pops one to go on, so each fused ancestor of the node walked
+ * keeps at most 7 entries; a fused node below the root spans at least two
+ * kd levels, so a tree of depth D has at most max(1, D) fused levels, and
+ * the host refuses trees deeper than kKdMaxDepth
+ * (src/rtcl/accel/kdtree_nodes.cpp), so the stack holds at most
+ * 7 kKdMaxDepth + 1 entries. */
+#include "shared/bvh8_stack.h"
 #include "shared/trace.h"
 
-/* One axis of the ray against the root box: narrows [*t0, *t1] to the
- * slab (conservatively widened, Ize 2013); a ray that does not move along
- * the axis limits nothing when its origin is within the slab. Returns 0
- * when the ray misses the slab. */
-inline int kd_clip_axis(float o, float d, float inv, float lower, float upper, float* t0, float* t1) {
-  if (d == 0.0f || !rtcl_is_finite(inv)) return o >= lower && o <= upper;
-  float tn = ((d > 0.0f ? lower : upper) - o) * inv;
-  float tf = ((d > 0.0f ? upper : lower) - o) * inv;
-  *t0 = fmax(*t0, tn - fabs(tn) * RTCL_SLAB_WIDEN);
-  *t1 = fmin(*t1, tf + fabs(tf) * RTCL_SLAB_WIDEN);
-  return 1;
-}
+#ifndef RTCL_KD_CELL_STACK
+#error "RTCL_KD_CELL_STACK (the stack bound of the deepest tree) must be defined"
+#endif
 
 /* Tests a leaf's references refs[first .. end) (triangles, then spheres as
  * ~r): the triangles' lanes in runs of eight, the spheres in batches of
@@ -99,86 +85,72 @@ inline int kd_test_leaf(global const int* refs, uint first, uint end, global con
   return 0;
 }
 
+/* The cells of a fused node the ray enters over [tmin, tmax] (lane = -1)
+ * and their entry distances. At the robust and exact levels, the slab test
+ * of box.h, whose fmin/fmax chain drops the NaN of (b - o) * inf for an
+ * origin on a face of a zero direction component. The fast level is
+ * compiled with -cl-fast-relaxed-math: the compiler may assume no NaN or
+ * inf (and the reciprocal of ±0 may come out NaN), so there an axis the ray
+ * does not move along only asks whether the origin lies in the slab; and
+ * the interval is widened as at the other levels, since a cell's box may be
+ * flat (a leaf of a flat scene) and a ray grazing it must still enter. */
+inline int8 kd_enter_cells8(global const Bvh8Node* node, const TraceRay* s, float tmax, float8* t_entry) {
+#ifdef RTCL_PRECISION_FAST
+  global const float8* b = (global const float8*)node->bounds;
+  float8 tn = (float8)(s->tmin), tf = (float8)(tmax);
+  int8 inside = (int8)(-1);
+#define KD_FAST_AXIS(A, O, D, I, NEAR, FAR)                                \
+  if (D == 0.0f) {                                                         \
+    inside &= b[A] <= (float8)(O) & (float8)(O) <= b[3 + (A)];             \
+  } else {                                                                 \
+    tn = rtcl_fmax8((b[NEAR] - (float8)(O)) * (float8)(I), tn);           \
+    tf = rtcl_fmin8((b[FAR] - (float8)(O)) * (float8)(I), tf);            \
+  }
+  KD_FAST_AXIS(0, s->ox, s->dx, s->ix, s->near_x, s->far_x)
+  KD_FAST_AXIS(1, s->oy, s->dy, s->iy, s->near_y, s->far_y)
+  KD_FAST_AXIS(2, s->oz, s->dz, s->iz, s->near_z, s->far_z)
+#undef KD_FAST_AXIS
+  tn -= fabs(tn) * RTCL_SLAB_WIDEN;
+  tf += fabs(tf) * RTCL_SLAB_WIDEN;
+  *t_entry = tn;
+  return inside & (tn <= tf);
+#else
+  return intersect_boxes8(node, s, tmax, t_entry);
+#endif
+}
+
 __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, global const KdHeader* header,
-                                               global const KdNode* nodes, global const int* refs,
-                                               global const float* lanes, global const int* lane_prims,
-                                               global const SphereBlock* spheres) {
+                                               global const KdNode* nodes, global const Bvh8Node* fused,
+                                               global const int* refs, global const float* lanes,
+                                               global const int* lane_prims, global const SphereBlock* spheres) {
   const int lane_stride = header->lane_stride;
-  float t_min = s->tmin, t_max = s->tmax;
-  if (!kd_clip_axis(s->ox, s->dx, s->ix, header->lower[0], header->upper[0], &t_min, &t_max)) return;
-  if (!kd_clip_axis(s->oy, s->dy, s->iy, header->lower[1], header->upper[1], &t_min, &t_max)) return;
-  if (!kd_clip_axis(s->oz, s->dz, s->iz, header->lower[2], header->upper[2], &t_min, &t_max)) return;
-  if (!(t_min <= t_max)) return;
-  uint stack_node[RTCL_KD_STACK];
-  float stack_min[RTCL_KD_STACK], stack_max[RTCL_KD_STACK];
-  int top = 0;
-  uint n = 0;
+  int stack_ref[RTCL_KD_CELL_STACK];
+  float stack_t[RTCL_KD_CELL_STACK]; /* the cell's min */
+  int sp = 0;
+  int ref = 0;
   for (;;) {
-    KdNode node = nodes[n];
-    uint axis = node.flags & 3u;
-    while (axis != RTCL_KD_LEAF) {
-      float o = axis == 0 ? s->ox : (axis == 1 ? s->oy : s->oz);
-      float d = axis == 0 ? s->dx : (axis == 1 ? s->dy : s->dz);
-      float inv = axis == 0 ? s->ix : (axis == 1 ? s->iy : s->iz);
-      float delta = as_float(node.data) - o;
-      float dist = delta * inv;
-      uint below = n + 1, above = node.flags >> 2;
-      int below_near = delta > 0.0f || (delta == 0.0f && d > 0.0f);
-      uint near = below_near ? below : above, far = below_near ? above : below;
-      int both = rtcl_is_nan(dist); /* in the plane: both, each over the whole interval */
-      if (!both) {
-        if (dist < 0.0f || dist * (1.0f - RTCL_SLAB_WIDEN) > t_max) {
-          n = near;
-        } else if (dist * (1.0f + RTCL_SLAB_WIDEN) < t_min) {
-          n = far;
-        } else {
-          both = 1;
-        }
+    if (ref >= 0) {
+      global const Bvh8Node* node = fused + ref;
+      float8 t_entry;
+      int8 hit = kd_enter_cells8(node, s, h->t_best, &t_entry);
+      if (rtcl_any8(hit)) {
+        RTCL_BVH8_PUSH_CHILDREN
       }
-      if (both) {
-        /* An empty leaf on either side is not visited (nor pushed). */
-        KdNode far_node = nodes[far];
-        if (KD_EMPTY(far_node)) {
-          if (!rtcl_is_nan(dist)) t_max = fmin(t_max, dist);
-          n = near;
-        } else {
-          KdNode near_node = nodes[near];
-          if (KD_EMPTY(near_node)) {
-            if (!rtcl_is_nan(dist)) t_min = fmax(t_min, dist);
-            n = far;
-            node = far_node;
-            axis = node.flags & 3u;
-            continue;
-          }
-          stack_node[top] = far;
-          stack_min[top] = rtcl_is_nan(dist) ? t_min : fmax(t_min, dist);
-          stack_max[top] = t_max;
-          ++top;
-          if (!rtcl_is_nan(dist)) t_max = fmin(t_max, dist);
-          n = near;
-          node = near_node;
-          axis = node.flags & 3u;
-          continue;
-        }
-      }
-      node = nodes[n];
-      axis = node.flags & 3u;
+    } else {
+      KdNode leaf = nodes[~ref];
+      uint first = leaf.flags >> 2;
+      if (kd_test_leaf(refs, first, first + leaf.data, lanes, lane_stride, lane_prims, spheres, s, h)) return;
     }
-    uint first = node.flags >> 2;
-    if (kd_test_leaf(refs, first, first + node.data, lanes, lane_stride, lane_prims, spheres, s, h)) return;
-    /* The next subtree whose interval may still hold a nearer hit. */
     do {
-      if (top == 0) return;
-      --top;
-      t_min = stack_min[top];
-    } while (h->t_best <= t_min - fabs(t_min) * KD_EXIT_MARGIN);
-    n = stack_node[top];
-    t_max = stack_max[top];
+      if (sp == 0) return;
+      --sp;
+    } while (stack_t[sp] > h->t_best);
+    ref = stack_ref[sp];
   }
 }
 
-#define KD_PARAMS                                                                            \
-  global const KdHeader *header, global const KdNode *nodes, global const int *refs,       \
+#define KD_PARAMS                                                                                         \
+  global const KdHeader *header, global const KdNode *nodes, global const Bvh8Node *fused, global const int *refs, \
       global const float *lanes, global const int *lane_prims, global const SphereBlock *spheres
-#define KD_ARGS header, nodes, refs, lanes, lane_prims, spheres
+#define KD_ARGS header, nodes, fused, refs, lanes, lane_prims, spheres
 RTCL_TRACE_KERNELS(kdtree, KD_PARAMS, KD_ARGS)

@@ -36,8 +36,10 @@
 #include "shared/kdtree.h"
 #include "shared/packet.h"
 
-/* One axis of the root box against the packet: kd_clip_axis per lane.
- * Returns the lanes whose ray meets the slab. */
+/* One axis of the root box against the packet, per lane: [t0, t1] narrowed
+ * to the slab (widened by RTCL_SLAB_WIDEN, Ize 2013); a lane that does not
+ * move along the axis keeps its interval when its origin is within the
+ * slab. Returns the lanes whose ray meets the slab. */
 inline int8 kdp_clip_axis(float8 o, float8 d, float8 inv, float lower, float upper, float8* t0, float8* t1) {
   int8 flat = (d == 0.0f) | !isfinite(inv);
   int8 pos = d > 0.0f;
@@ -169,8 +171,10 @@ __attribute__((noinline)) void kdtree_packet_traverse(const TracePacket* p, Pack
   }
 }
 
+/* The argument list of accel/kdtree.cl (one for both kernels of a
+ * structure); the fused nodes are the single-ray traversal's, unused here. */
 #define KD_PACKET_PARAMS                                                                              \
-  global const KdHeader *header, global const KdNode *nodes, global const int *refs, global const float *lanes, \
-      global const int *lane_prims, global const SphereBlock *spheres
+  global const KdHeader *header, global const KdNode *nodes, global const Bvh8Node *fused, global const int *refs, \
+      global const float *lanes, global const int *lane_prims, global const SphereBlock *spheres
 #define KD_PACKET_ARGS header, nodes, refs, lanes, lane_prims, spheres
 RTCL_PACKET_KERNELS(kdtree_packet, KD_PACKET_PARAMS, KD_PACKET_ARGS)

@@ -1,6 +1,6 @@
-/* What the kd-tree kernels (accel/kdtree.cl, accel/kdtree_packet.cl) share:
- * the early-exit margin and the empty-leaf test. See accel/kdtree.cl for
- * the traversal's contract. */
+/* The kd-tree packet traversal's (accel/kdtree_packet.cl) stack bound,
+ * early-exit margin and empty-leaf test. See accel/kdtree.cl for the
+ * single-ray traversal's contract. */
 #ifndef RTCL_SHARED_KDTREE_H
 #define RTCL_SHARED_KDTREE_H
 

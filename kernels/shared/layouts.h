@@ -248,6 +248,17 @@ typedef struct KdNode {
 #define RTCL_KD_INNER(axis, above) ((rtcl_u32)(axis) | ((rtcl_u32)(above) << 2))
 #define RTCL_KD_LEAF_NODE(first) (RTCL_KD_LEAF | ((rtcl_u32)(first) << 2))
 
+/* The single-ray traversal's nodes (kernels/accel/kdtree.cl; built by
+ * src/rtcl/accel/kdtree_fused.cpp from the KdNode array) are Bvh8Node
+ * records, each a subtree of the kd-tree cut off at up to eight cells
+ * (kd nodes whose cells tile the subtree root's cell, less empty leaves):
+ * lane k's bounds are its cell's box shrunk to what it holds (a leaf: its
+ * primitives clipped to the cell; an inner kd node: the union of its fused
+ * node's lanes), and child[k] >= 0 is the fused node of an inner kd node,
+ * < 0 the leaf ~child[k] of the KdNode array, RTCL_KD_NO_CELL an unused
+ * lane (bounds lower = +inf, upper = -inf). */
+#define RTCL_KD_NO_CELL 0x7fffffff
+
 /* The tree's root box [lower, upper] (closed, float), which contains every
  * stored primitive; traversal clips the ray to it; and the rows' stride of
  * the reference lanes (KdNode). 48 bytes; element [3] of each row is

@@ -1,5 +1,7 @@
 #include "rtcl/accel/kdtree_nodes.hpp"
 
+#include "rtcl/accel/kdtree_fused.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <cfloat>
@@ -69,7 +71,8 @@ float kd_round_float(double x, bool down) {
 }
 
 std::size_t KdTree::bytes() const {
-  return sizeof(KdHeader) + nodes.size() * sizeof(KdNode) + refs.size() * sizeof(rtcl_i32) +
+  return sizeof(KdHeader) + nodes.size() * sizeof(KdNode) + fused.size() * sizeof(Bvh8Node) +
+         refs.size() * sizeof(rtcl_i32) +
          lanes.size() * sizeof(float) + lane_prims.size() * sizeof(rtcl_i32) +
          blocks.spheres.size() * sizeof(SphereBlock);
 }
@@ -157,6 +160,28 @@ KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const
   if (max_alloc_bytes && tree.nodes.size() * sizeof(KdNode) > max_alloc_bytes)
     too_large(what, option, std::to_string(tree.nodes.size()) + " nodes", tree.nodes.size() * sizeof(KdNode),
               max_alloc_bytes);
+  // A leaf's cell box shrunk to what its primitives clipped to the
+  // (widened) cell cover, rounded outwards.
+  tree.fused = fuse_kd_nodes(tree.nodes, tree.header, [&](std::size_t leaf, const KdBox& cell) {
+    KdBox tight = KdBox::empty();
+    glm::dvec3 lo(cell.lower[0], cell.lower[1], cell.lower[2]), hi(cell.upper[0], cell.upper[1], cell.upper[2]);
+    const std::uint32_t first = tree.nodes[leaf].flags >> 2, count = tree.nodes[leaf].data;
+    for (std::uint32_t k = first; k < first + count; ++k) {
+      const rtcl_i32 r = tree.refs[k];
+      const std::uint32_t i = r >= 0 ? static_cast<std::uint32_t>(r)
+                                     : static_cast<std::uint32_t>(prims.triangle_count) + static_cast<std::uint32_t>(~r);
+      glm::dvec3 cl, cu;
+      if (!prims.clip(i, lo, hi, &cl, &cu)) continue;
+      for (int a = 0; a < 3; ++a) {
+        tight.lower[a] = std::min(tight.lower[a], kd_round_float(cl[a], true));
+        tight.upper[a] = std::max(tight.upper[a], kd_round_float(cu[a], false));
+      }
+    }
+    return tight;
+  });
+  if (max_alloc_bytes && tree.fused.size() * sizeof(Bvh8Node) > max_alloc_bytes)
+    too_large(what, option, std::to_string(tree.fused.size()) + " fused nodes",
+              tree.fused.size() * sizeof(Bvh8Node), max_alloc_bytes);
   if (max_alloc_bytes && tree.refs.size() * sizeof(rtcl_i32) > max_alloc_bytes)
     too_large(what, option, std::to_string(tree.refs.size()) + " references", tree.refs.size() * sizeof(rtcl_i32),
               max_alloc_bytes);
@@ -204,6 +229,7 @@ class KdAccel final : public Accel {
               stats, config),
         header_(device.upload(&tree.header, sizeof tree.header, (name + " header").c_str())),
         nodes_(device.upload(tree.nodes.data(), tree.nodes.size() * sizeof(KdNode), (name + " nodes").c_str())),
+        fused_(device.upload(tree.fused.data(), tree.fused.size() * sizeof(Bvh8Node), (name + " fused nodes").c_str())),
         refs_(tree.refs.empty() ? device.upload(&kNoRef, sizeof kNoRef, (name + " references").c_str())
                                 : device.upload(tree.refs.data(), tree.refs.size() * sizeof(rtcl_i32),
                                                 (name + " references").c_str())),
@@ -219,19 +245,21 @@ class KdAccel final : public Accel {
   static std::vector<std::string> defines(const Geometry& geometry) {
     std::vector<std::string> d = primitive_defines(geometry);
     d.push_back("RTCL_KD_STACK=" + std::to_string(kKdMaxDepth));
+    d.push_back("RTCL_KD_CELL_STACK=" + std::to_string(kKdCellStack));
     return d;
   }
 
   void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
     kernel.setArg(first, header_);
     kernel.setArg(first + 1, nodes_);
-    kernel.setArg(first + 2, refs_);
-    kernel.setArg(first + 3, lanes_);
-    kernel.setArg(first + 4, lane_prims_);
-    kernel.setArg(first + 5, primitives_.spheres);
+    kernel.setArg(first + 2, fused_);
+    kernel.setArg(first + 3, refs_);
+    kernel.setArg(first + 4, lanes_);
+    kernel.setArg(first + 5, lane_prims_);
+    kernel.setArg(first + 6, primitives_.spheres);
   }
 
-  cl::Buffer header_, nodes_, refs_, lanes_, lane_prims_;
+  cl::Buffer header_, nodes_, fused_, refs_, lanes_, lane_prims_;
   DevicePrimitives primitives_;
 };
 

@@ -31,6 +31,7 @@ constexpr int kKdMaxDepth = 64;
 struct KdTree {
   KdHeader header{};
   std::vector<KdNode> nodes;      // depth-first, root first
+  std::vector<Bvh8Node> fused;    // up to eight cells per node (kdtree_fused.hpp)
   std::vector<rtcl_i32> refs;     // leaf reference lists
   // Reference lanes (KdNode): 9 rows of header.lane_stride floats, and the
   // primitive id of each position; what the kernel tests triangles from.
