@@ -17,6 +17,7 @@
 #include "rtcl/accel/brute.hpp"
 #include "rtcl/accel/bsp.hpp"
 #include "rtcl/accel/kdtree.hpp"
+#include "rtcl/accel/kdtree_fused.hpp"
 #include "rtcl/bounds/clip.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/render/ray_order.hpp"
@@ -72,6 +73,93 @@ TEST(KdBuild, SahCutsOffEmptySpaceAndStopsWhenNoSplitPays) {
   EXPECT_LT(build_kdtree(soup).references_per_primitive(), build_bsp(soup).references_per_primitive());
 }
 
+KdTreeConfig exact_below(std::size_t n) {
+  KdTreeConfig c;
+  c.exact_below = n;
+  return c;
+}
+
+TEST(KdBuild, BinnedAndExactSplitsBothCutOffEmptySpace) {
+  // Two clusters far apart: the first split separates them, whether the
+  // root is split at bin boundaries or by the exact sweep.
+  Geometry a = random_soup(600, 11, 0.02f, 0.1f);
+  Geometry b = random_soup(600, 12, 0.02f, 0.1f, glm::vec3(0.9f));
+  Geometry g = a;
+  auto base = static_cast<std::uint32_t>(g.vertices.size());
+  g.vertices.insert(g.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (glm::uvec3 t : b.triangles) g.triangles.push_back(t + base);
+  g.source = "two clusters";
+  for (std::size_t exact : {std::size_t{0}, std::size_t{1} << 30}) {
+    KdTree t = build_kdtree(g, exact_below(exact));
+    ASSERT_NE(t.nodes[0].flags & 3u, RTCL_KD_LEAF) << exact;
+    float split = std::bit_cast<float>(t.nodes[0].data);
+    EXPECT_GT(split, 0.1f) << exact;
+    EXPECT_LT(split, 0.9f) << exact;
+  }
+}
+
+// The build's threads change nothing in the tree: the binned levels hand
+// whole subtrees to workers, and the exact build's subtrees do not depend
+// on which thread builds them.
+TEST(KdBuild, TheTreeDoesNotDependOnTheThreads) {
+  Geometry g = random_soup(20000, 13);
+  for (std::size_t exact : {std::size_t{0}, std::size_t{64}, std::size_t{1} << 30}) {
+    KdTreeConfig one = exact_below(exact), two = exact_below(exact);
+    one.thread_count = 1;
+    two.thread_count = 2;
+    KdTree a = build_kdtree(g, one), b = build_kdtree(g, two);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size()) << exact;
+    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(KdNode)), 0) << exact;
+    EXPECT_EQ(a.refs, b.refs) << exact;
+    ASSERT_EQ(a.fused.size(), b.fused.size()) << exact;
+    EXPECT_EQ(std::memcmp(a.fused.data(), b.fused.data(), a.fused.size() * sizeof(Bvh8Node)), 0) << exact;
+  }
+}
+
+// The builder's leaf boxes (the union of the bounds it clipped while
+// splitting) hold the boxes a fresh clip of each leaf's primitives to its
+// cell gives (what flatten_kd_tree computes for builders that do not keep
+// them, as the BSP), and almost all are the same box: the two differ only
+// where a later plane, which did not cut the clipped part, re-rounds it.
+TEST(KdBuild, LeafBoxesAreThoseOfTheTrianglesClippedToTheirCells) {
+  Geometry g = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
+  validate(g);
+  KdPrimitives prims = kd_primitives(g, "kdtree", 0);
+  for (std::size_t exact : {std::size_t{0}, std::size_t{1} << 30}) {
+    KdTree t = build_kdtree(g, exact_below(exact));
+    std::vector<Bvh8Node> clipped = fuse_kd_nodes(t.nodes, t.header, [&](std::size_t leaf, const KdBox& cell) {
+      KdBox box = KdBox::empty();
+      glm::dvec3 lo(cell.lower[0], cell.lower[1], cell.lower[2]), hi(cell.upper[0], cell.upper[1], cell.upper[2]);
+      const std::uint32_t first = t.nodes[leaf].flags >> 2;
+      for (std::uint32_t k = first; k < first + t.nodes[leaf].data; ++k) {
+        glm::dvec3 cl, cu;
+        if (!prims.clip(static_cast<std::uint32_t>(t.refs[k]), lo, hi, &cl, &cu)) continue;
+        for (int a = 0; a < 3; ++a) {
+          box.lower[a] = std::min(box.lower[a], kd_round_float(cl[a], true));
+          box.upper[a] = std::max(box.upper[a], kd_round_float(cu[a], false));
+        }
+      }
+      return box;
+    });
+    ASSERT_EQ(clipped.size(), t.fused.size()) << exact;
+    std::size_t lanes = 0, same = 0;
+    for (std::size_t i = 0; i < clipped.size(); ++i)
+      for (int k = 0; k < 8; ++k) {
+        if (t.fused[i].child[k] == RTCL_KD_NO_CELL) continue;
+        ++lanes;
+        bool equal = true;
+        for (int a = 0; a < 3; ++a) {
+          EXPECT_LE(t.fused[i].bounds[a][k], clipped[i].bounds[a][k]) << exact << " node " << i << " lane " << k;
+          EXPECT_GE(t.fused[i].bounds[3 + a][k], clipped[i].bounds[3 + a][k]) << exact << " node " << i;
+          equal = equal && t.fused[i].bounds[a][k] == clipped[i].bounds[a][k] &&
+                  t.fused[i].bounds[3 + a][k] == clipped[i].bounds[3 + a][k];
+        }
+        same += equal;
+      }
+    EXPECT_GE(static_cast<double>(same), 0.99 * static_cast<double>(lanes)) << exact;
+  }
+}
+
 TEST(KdBuild, BadOptionsAreErrorsNamingTheOption) {
   Geometry g = random_soup(10, 1);
   auto message = [&](const KdTreeConfig& c) { return error_of([&] { build_kdtree(g, c); }); };
@@ -110,11 +198,18 @@ Geometry soup_and_spheres(std::size_t triangles, std::uint32_t seed) {
 TEST(KdTrace, MatchesBruteForceOnSoupsAndSplitPlaneRays) {
   Geometry g = soup_and_spheres(600, 5);
   // The default costs (leaves of up to a few runs of 8) and the classic SAH
-  // (a cost per primitive: a deeper tree of small leaves, more planes).
+  // (a cost per primitive: a deeper tree of small leaves, more planes),
+  // each split only by binning and only by the exact sweep.
   KdTreeConfig classic;
   classic.batch = 1;
   classic.traversal_cost = 30.0;
-  for (const KdTreeConfig& config : {KdTreeConfig{}, classic}) {
+  std::vector<KdTreeConfig> configs;
+  for (KdTreeConfig c : {KdTreeConfig{}, classic})
+    for (std::size_t exact : {std::size_t{0}, std::size_t{1} << 30}) {
+      c.exact_below = exact;
+      configs.push_back(c);
+    }
+  for (const KdTreeConfig& config : configs) {
     KdTree t = build_kdtree(g, config);
     std::vector<Ray> rays = random_rays(g, 600, 6);
     std::vector<Ray> planes = split_plane_rays(t, 7, 1200);

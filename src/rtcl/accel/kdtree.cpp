@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -12,8 +13,6 @@
 namespace rtcl {
 
 namespace {
-
-constexpr std::size_t kParallelMin = 4096;
 
 // A boundary event of a primitive's clipped bounds on one axis (Wald &
 // Havran 2006, section 4.2): its lower end (start), its upper end (end), or
@@ -30,19 +29,21 @@ struct Event {
   bool operator<(const Event& o) const { return pos < o.pos || (pos == o.pos && type < o.type); }
 };
 
-using Events = std::array<std::vector<Event>, 3>;
+// A primitive's bounds clipped to a node's (widened) box, rounded outwards
+// to float: what both the binned and the exact split see of it.
+struct Ref {
+  std::array<float, 3> lower, upper;
+  std::uint32_t prim;
+};
 
-// Event positions enclose the double-precision bounds.
-void add_events(Events& events, std::uint32_t prim, const glm::dvec3& lower, const glm::dvec3& upper) {
+Ref make_ref(std::uint32_t prim, const glm::dvec3& lower, const glm::dvec3& upper) {
+  Ref r;
+  r.prim = prim;
   for (int k = 0; k < 3; ++k) {
-    float lo = kd_round_float(lower[k], true), hi = kd_round_float(upper[k], false);
-    if (lo == hi) {
-      events[k].push_back({lo, prim, kPlanar});
-    } else {
-      events[k].push_back({lo, prim, kStart});
-      events[k].push_back({hi, prim, kEnd});
-    }
+    r.lower[k] = kd_round_float(lower[k], true);
+    r.upper[k] = kd_round_float(upper[k], false);
   }
+  return r;
 }
 
 struct Split {
@@ -52,44 +53,177 @@ struct Split {
   std::size_t n_below = 0, n_above = 0;  // primitives each side lists
 };
 
+// Nodes of at least this many references may be built on another thread.
+constexpr std::size_t kParallelMin = 4096;
+
+// Candidate planes per axis of a binned split: the boundaries of this many
+// equal bins over the node box.
+constexpr int kBins = 64;
+
 // Primitive sides during one split (bit 0: below, bit 1: above).
 enum Side : std::uint8_t { kBelow = 1, kAbove = 2, kBoth = 3 };
 
-class KdBuilder {
- public:
-  KdBuilder(const KdPrimitives& prims, const KdTreeConfig& config, int depth, unsigned threads)
-      : prims_(prims), config_(config), max_depth_(depth), threads_(static_cast<int>(threads) - 1) {}
+// A subtree left to a worker thread: its root's placeholder in the tree,
+// box and references, and where it stands in depth and reference budget.
+struct KdTask {
+  KdBuildNode* node;
+  glm::dvec3 lower, upper;
+  std::vector<Ref> refs;
+  int depth;
+  double budget;
+};
 
-  // `budget`: the references this subtree may list (kKdReferenceBudget).
-  std::unique_ptr<KdBuildNode> build(const glm::dvec3& lower, const glm::dvec3& upper, Events events, int depth,
-                                     double budget, std::vector<std::uint8_t>& side) {
-    auto node = std::make_unique<KdBuildNode>();
+// The split cost and the leaf cost of the SAH (KdTreeConfig), shared by the
+// binned and the exact split.
+class KdCost {
+ public:
+  explicit KdCost(const KdTreeConfig& config) : config_(config), per_batch_(1.0 / config.batch) {}
+
+  double leaf(std::size_t n) const { return config_.intersection_cost * tests(n); }
+
+  // Intersection tests a leaf of n primitives costs: one per batch of
+  // config.batch (the kernel tests up to 8 at once in float8 lanes).
+  // ceil(n / batch) without an integer division or a call to floor (the
+  // sweeps evaluate it twice per candidate plane): the double quotient is
+  // at least 1/8 from the next integer below it, far beyond its rounding
+  // for n < 2^30, and truncation is floor for it.
+  double tests(std::size_t n) const {
+    return static_cast<double>(static_cast<std::uint64_t>(static_cast<double>(n + config_.batch - 1) * per_batch_));
+  }
+
+  const KdTreeConfig& config() const { return config_; }
+
+ private:
+  const KdTreeConfig& config_;
+  double per_batch_;
+};
+
+// The SAH cost of the splits of one node's box [lower, upper].
+class KdSplitCost {
+ public:
+  KdSplitCost(const KdCost& cost, const glm::dvec3& lower, const glm::dvec3& upper)
+      : cost_(cost), lower_(lower), upper_(upper) {
+    glm::dvec3 e = upper - lower;
+    double area = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
+    valid_ = area > 0.0;
+    double scale = cost.config().intersection_cost / area;
+    for (int k = 0; k < 3; ++k) {
+      int a = (k + 1) % 3, b = (k + 2) % 3;
+      cross_[k] = 2.0 * e[a] * e[b] * scale;
+      perimeter_[k] = 2.0 * (e[a] + e[b]) * scale;
+    }
+  }
+
+  // False for a node without area (no split is cheaper than its leaf).
+  bool valid() const { return valid_; }
+
+  // Split at p on axis k with n_below and n_above primitives listed each
+  // side.
+  double operator()(int k, double p, std::size_t n_below, std::size_t n_above) const {
+    const KdTreeConfig& c = cost_.config();
+    double below = cross_[k] + (p - lower_[k]) * perimeter_[k];
+    double above = cross_[k] + (upper_[k] - p) * perimeter_[k];
+    double cost = c.traversal_cost + below * cost_.tests(n_below) + above * cost_.tests(n_above);
+    if (n_below == 0 || n_above == 0) cost *= 1.0 - c.empty_bonus;
+    return cost;
+  }
+
+ private:
+  const KdCost& cost_;
+  glm::dvec3 lower_, upper_;
+  std::array<double, 3> cross_, perimeter_;  // scaled by ci / area
+  bool valid_;
+};
+
+// Both builds list a primitive below a plane p on axis k when its bounds
+// start before p, above when they end after it, on both sides when they are
+// flat on p. Bounds ending exactly at p are below only (they are rounded
+// outwards, so the primitive does not reach beyond p), starting at p above
+// only. Widening here would list a primitive ending at p as a sliver on the
+// far side, which the SAH cuts around again and again.
+std::uint8_t side_of(float lower, float upper, float p) {
+  if (lower == p && upper == p) return kBoth;
+  return static_cast<std::uint8_t>((lower < p ? kBelow : 0) | (upper > p ? kAbove : 0));
+}
+
+// The leaf of `node` listing `prims` (sorted), with the union of their
+// clipped bounds.
+void make_leaf(KdBuildNode& node, std::vector<std::uint32_t> prims, const KdBox& content) {
+  node.prims = std::move(prims);
+  std::sort(node.prims.begin(), node.prims.end());
+  node.has_content = true;
+  node.content = content;
+}
+
+// The exact build of Wald & Havran 2006, O(N log N): the events of a
+// subtree's references sorted once per axis, one sweep per axis over every
+// event position of a node, the children's lists filtered from the
+// parent's (keeping them sorted) and merged with the re-sorted events of
+// the straddling primitives clipped to each child. Subtrees of at least
+// kParallelMin references go to spare host threads.
+class ExactBuilder {
+ public:
+  ExactBuilder(const KdPrimitives& prims, const KdTreeConfig& config, int max_depth, unsigned threads)
+      : prims_(prims), cost_(config), max_depth_(max_depth), threads_(static_cast<int>(threads) - 1) {}
+
+  void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, const std::vector<Ref>& refs,
+             int depth, double budget) {
+    Events events;
+    for (auto& list : events) list.reserve(2 * refs.size());
+    for (const Ref& r : refs) add_events(events, r);
+    if (refs.size() >= kParallelMin && threads_.try_take()) {
+      std::thread y([&] { std::sort(events[1].begin(), events[1].end()); });
+      std::sort(events[0].begin(), events[0].end());
+      std::sort(events[2].begin(), events[2].end());
+      y.join();
+      threads_.give_back();
+    } else {
+      for (auto& list : events) std::sort(list.begin(), list.end());
+    }
+    if (side_.empty()) side_.assign(prims_.size(), 0);
+    build(node, lower, upper, std::move(events), depth, budget, side_);
+  }
+
+ private:
+  using Events = std::array<std::vector<Event>, 3>;
+
+  static void add_events(Events& events, const Ref& r) {
+    for (int k = 0; k < 3; ++k) {
+      if (r.lower[k] == r.upper[k]) {
+        events[k].push_back({r.lower[k], r.prim, kPlanar});
+      } else {
+        events[k].push_back({r.lower[k], r.prim, kStart});
+        events[k].push_back({r.upper[k], r.prim, kEnd});
+      }
+    }
+  }
+
+  // `side`: all zero, one entry per primitive, this thread's.
+  void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, Events events, int depth,
+             double budget, std::vector<std::uint8_t>& side) {
     std::size_t n = 0;
     for (const Event& e : events[0]) n += e.type != kEnd;
     Split split;
     if (depth < max_depth_ && n > 0) split = find_split(lower, upper, events, n);
     const int k = split.axis;
     const float p = split.pos;
-    std::size_t n_below = 0, n_above = 0;
-    if (k >= 0) {
-      n_below = split.n_below;
-      n_above = split.n_above;
-    }
-    double both = static_cast<double>(n_below + n_above);
+    double both = static_cast<double>(split.n_below + split.n_above);
     if (k < 0 || both > budget) {
+      std::vector<std::uint32_t> prims;
+      prims.reserve(n);
       for (const Event& e : events[0])
-        if (e.type != kEnd) node->prims.push_back(e.prim);
-      std::sort(node->prims.begin(), node->prims.end());
-      return node;
+        if (e.type != kEnd) prims.push_back(e.prim);
+      KdBox content = KdBox::empty();
+      for (int a = 0; a < 3 && n > 0; ++a) {
+        content.lower[a] = events[a].front().pos;
+        content.upper[a] = events[a].back().pos;
+      }
+      make_leaf(node, std::move(prims), content);
+      return;
     }
-    node->axis = k;
-    node->split = p;
-    // Sides, as the sweep counted them: below when the bounds start before
-    // p, above when they end after it, both for bounds flat on p. Bounds
-    // ending exactly at p are below only (event positions are rounded
-    // outwards, so the primitive does not reach beyond p), starting at p
-    // above only. Widening here would list a primitive ending at p as a
-    // sliver on the far side, which the SAH cuts around again and again.
+    node.axis = k;
+    node.split = p;
+    // Sides, as the sweep counted them (side_of).
     for (const Event& e : events[k]) {
       if (e.type == kPlanar && e.pos == p) {
         side[e.prim] = kBoth;
@@ -103,21 +237,19 @@ class KdBuilder {
     above_lower[k] = p;
     Events below, above, below_new, above_new;
     for (int a = 0; a < 3; ++a) {
-      below[a].reserve(events[a].size());
-      above[a].reserve(events[a].size());
+      below[a].reserve(2 * split.n_below);
+      above[a].reserve(2 * split.n_above);
       for (const Event& e : events[a]) {
         if (side[e.prim] == kBelow) below[a].push_back(e);
         else if (side[e.prim] == kAbove) above[a].push_back(e);
       }
     }
-    // Straddling primitives: clipped again to each child (perfect splits;
-    // one that does not reach a child is dropped from it).
     glm::dvec3 cl, cu;
     for (const Event& e : events[k]) {
       if (e.type == kEnd) continue;
       if (side[e.prim] == kBoth) {
-        if (prims_.clip(e.prim, lower, below_upper, &cl, &cu)) add_events(below_new, e.prim, cl, cu);
-        if (prims_.clip(e.prim, above_lower, upper, &cl, &cu)) add_events(above_new, e.prim, cl, cu);
+        if (prims_.clip(e.prim, lower, below_upper, &cl, &cu)) add_events(below_new, make_ref(e.prim, cl, cu));
+        if (prims_.clip(e.prim, above_lower, upper, &cl, &cu)) add_events(above_new, make_ref(e.prim, cl, cu));
       }
       side[e.prim] = 0;
     }
@@ -128,26 +260,26 @@ class KdBuilder {
     }
     below_new = {};
     above_new = {};
-    // The children's shares of the budget, from the sweep's counts (an
-    // upper bound of what the clipping keeps).
-    double below_budget = budget * static_cast<double>(n_below) / both;
-    double above_budget = budget * static_cast<double>(n_above) / both;
+    // The children's shares of the budget, from the sweep's counts (upper
+    // bounds of what the clipping keeps).
+    double below_budget = budget * static_cast<double>(split.n_below) / both;
+    double above_budget = budget * static_cast<double>(split.n_above) / both;
+    node.below = std::make_unique<KdBuildNode>();
+    node.above = std::make_unique<KdBuildNode>();
     if (n >= kParallelMin && threads_.try_take()) {
       std::thread worker([&] {
         std::vector<std::uint8_t> own(prims_.size(), 0);
-        node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget, own);
+        build(*node.below, lower, below_upper, std::move(below), depth + 1, below_budget, own);
       });
-      node->above = build(above_lower, upper, std::move(above), depth + 1, above_budget, side);
+      build(*node.above, above_lower, upper, std::move(above), depth + 1, above_budget, side);
       worker.join();
       threads_.give_back();
     } else {
-      node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget, side);
-      node->above = build(above_lower, upper, std::move(above), depth + 1, above_budget, side);
+      build(*node.below, lower, below_upper, std::move(below), depth + 1, below_budget, side);
+      build(*node.above, above_lower, upper, std::move(above), depth + 1, above_budget, side);
     }
-    return node;
   }
 
- private:
   static void merge_in(std::vector<Event>& into, std::vector<Event>& added) {
     if (added.empty()) return;
     std::sort(added.begin(), added.end());
@@ -156,27 +288,16 @@ class KdBuilder {
     std::inplace_merge(into.begin(), into.begin() + static_cast<std::ptrdiff_t>(middle), into.end());
   }
 
-  // Intersection tests a leaf of n primitives costs: one per batch of
-  // config.batch (the kernel tests up to 8 at once in float8 lanes).
-  double tests(std::size_t n) const {
-    return static_cast<double>(config_.batch == 1 ? n : (n + config_.batch - 1) / config_.batch);
-  }
-
   // The sweep over each axis's sorted events (Wald & Havran 2006,
   // algorithm 4): N_L, N_P, N_R at every event position strictly inside
   // the node. Planar primitives at the plane count on both sides (the
-  // build lists them on both). Returns axis -1 when no split beats a leaf.
+  // build lists them on both). Axis -1 when no split beats a leaf.
   Split find_split(const glm::dvec3& lower, const glm::dvec3& upper, const Events& events, std::size_t n) const {
-    glm::dvec3 e = upper - lower;
-    double area = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
     Split best;
-    best.cost = config_.intersection_cost * tests(n);
-    if (!(area > 0.0)) return best;
-    // cost = ct + ci / area * (area_below * N_below + area_above * N_above)
-    const double scale = config_.intersection_cost / area;
+    best.cost = cost_.leaf(n);
+    KdSplitCost split_cost(cost_, lower, upper);
+    if (!split_cost.valid()) return best;
     for (int k = 0; k < 3; ++k) {
-      int a = (k + 1) % 3, b = (k + 2) % 3;
-      double cross = 2.0 * e[a] * e[b], perimeter = 2.0 * (e[a] + e[b]);
       std::size_t left = 0, right = n;
       const std::vector<Event>& list = events[k];
       for (std::size_t i = 0; i < list.size();) {
@@ -188,11 +309,7 @@ class KdBuilder {
         right -= planar + ending;
         if (p > lower[k] && p < upper[k]) {
           std::size_t n_below = left + planar, n_above = right + planar;
-          double area_below = cross + (p - lower[k]) * perimeter;
-          double area_above = cross + (upper[k] - p) * perimeter;
-          double cost =
-              config_.traversal_cost + scale * (area_below * tests(n_below) + area_above * tests(n_above));
-          if (n_below == 0 || n_above == 0) cost *= 1.0 - config_.empty_bonus;
+          double cost = split_cost(k, p, n_below, n_above);
           if (cost < best.cost) best = {k, p, cost, n_below, n_above};
         }
         left += starting + planar;
@@ -202,10 +319,178 @@ class KdBuilder {
   }
 
   const KdPrimitives& prims_;
-  const KdTreeConfig& config_;
+  KdCost cost_;
   int max_depth_;
   KdThreads threads_;
+  std::vector<std::uint8_t> side_;  // this thread's sides, all zero between splits
 };
+
+// The binned build: the same costs, sides and perfect splits as the exact
+// one, the planes at the boundaries of up to kBins equal bins per axis
+// (min-max binning: a reference counts in the bin of its lower and of its
+// upper bound), linear in a node's references with no sorting. Nodes of at
+// most config.exact_below references go to the exact build.
+class BinnedBuilder {
+ public:
+  BinnedBuilder(const KdPrimitives& prims, const KdTreeConfig& config, int max_depth)
+      : prims_(prims), config_(config), cost_(config), max_depth_(max_depth), exact_(prims, config, max_depth, 1) {}
+
+  // Builds the subtree of `node`; with `deferred`, nodes of at most
+  // `defer_at` references below this one are left there instead (their
+  // subtrees built later, on other threads). `budget`: the references the
+  // subtree may list (kKdReferenceBudget).
+  void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, std::vector<Ref> refs, int depth,
+             double budget, std::size_t defer_at = 0, std::vector<KdTask>* deferred = nullptr) {
+    const std::size_t n = refs.size();
+    if (n <= config_.exact_below) {
+      exact_.build(node, lower, upper, refs, depth, budget);
+      return;
+    }
+    Split split;
+    if (depth < max_depth_) split = find_split(lower, upper, refs);
+    const int k = split.axis;
+    const float p = split.pos;
+    double both = static_cast<double>(split.n_below + split.n_above);
+    if (k < 0 || both > budget) {
+      std::vector<std::uint32_t> prims;
+      prims.reserve(n);
+      KdBox content = KdBox::empty();
+      for (const Ref& r : refs) {
+        prims.push_back(r.prim);
+        content.grow({{r.lower[0], r.lower[1], r.lower[2]}, {r.upper[0], r.upper[1], r.upper[2]}});
+      }
+      make_leaf(node, std::move(prims), content);
+      return;
+    }
+    node.axis = k;
+    node.split = p;
+    glm::dvec3 below_upper = upper, above_lower = lower;
+    below_upper[k] = p;
+    above_lower[k] = p;
+    std::vector<Ref> below, above;
+    below.reserve(split.n_below);
+    above.reserve(split.n_above);
+    glm::dvec3 cl, cu;
+    for (const Ref& r : refs) {
+      std::uint8_t side = side_of(r.lower[k], r.upper[k], p);
+      if (side == kBelow) {
+        below.push_back(r);
+      } else if (side == kAbove) {
+        above.push_back(r);
+      } else {
+        if (prims_.clip(r.prim, lower, below_upper, &cl, &cu)) below.push_back(make_ref(r.prim, cl, cu));
+        if (prims_.clip(r.prim, above_lower, upper, &cl, &cu)) above.push_back(make_ref(r.prim, cl, cu));
+      }
+    }
+    refs = {};
+    // The children's shares of the budget, from the split's counts (upper
+    // bounds of what the clipping keeps).
+    node.below = std::make_unique<KdBuildNode>();
+    node.above = std::make_unique<KdBuildNode>();
+    child(*node.below, lower, below_upper, std::move(below), depth + 1,
+          budget * static_cast<double>(split.n_below) / both, defer_at, deferred);
+    child(*node.above, above_lower, upper, std::move(above), depth + 1,
+          budget * static_cast<double>(split.n_above) / both, defer_at, deferred);
+  }
+
+ private:
+  void child(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, std::vector<Ref> refs, int depth,
+             double budget, std::size_t defer_at, std::vector<KdTask>* deferred) {
+    if (deferred && refs.size() <= defer_at)
+      deferred->push_back({&node, lower, upper, std::move(refs), depth, budget});
+    else
+      build(node, lower, upper, std::move(refs), depth, budget, defer_at, deferred);
+  }
+
+  // Planes at the bin boundaries strictly inside the node (as many bins as
+  // references, from 8 to kBins): N_below counts the references whose
+  // lower bound lies in a bin below the plane, N_above those whose upper
+  // bound lies in a bin above it (both upper bounds of what the split
+  // lists). Axis -1 when no plane beats a leaf.
+  Split find_split(const glm::dvec3& lower, const glm::dvec3& upper, const std::vector<Ref>& refs) const {
+    const std::size_t n = refs.size();
+    Split best;
+    best.cost = cost_.leaf(n);
+    KdSplitCost split_cost(cost_, lower, upper);
+    if (!split_cost.valid()) return best;
+    const int bins = static_cast<int>(std::clamp<std::size_t>(n, 8, kBins));
+    std::array<std::array<std::uint32_t, kBins>, 3> starts, ends;
+    glm::dvec3 extent = upper - lower;
+    std::array<float, 3> origin, to_bin;
+    for (int k = 0; k < 3; ++k) {
+      std::fill_n(starts[k].begin(), bins, 0u);
+      std::fill_n(ends[k].begin(), bins, 0u);
+      origin[k] = static_cast<float>(lower[k]);
+      to_bin[k] = extent[k] > 0.0 ? static_cast<float>(bins / extent[k]) : 0.0f;
+    }
+    const float last = static_cast<float>(bins - 1);
+    auto bin = [&](float x, int k) {
+      return static_cast<int>(std::min(std::max((x - origin[k]) * to_bin[k], 0.0f), last));
+    };
+    for (const Ref& r : refs)
+      for (int k = 0; k < 3; ++k) {
+        ++starts[k][bin(r.lower[k], k)];
+        ++ends[k][bin(r.upper[k], k)];
+      }
+    for (int k = 0; k < 3; ++k) {
+      if (!(extent[k] > 0.0)) continue;
+      std::size_t left = 0, right = n;
+      const double step = extent[k] / bins;
+      for (int j = 1; j < bins; ++j) {
+        left += starts[k][j - 1];
+        right -= ends[k][j - 1];
+        float p = static_cast<float>(lower[k] + step * j);
+        if (!(p > lower[k] && p < upper[k])) continue;
+        double cost = split_cost(k, p, left, right);
+        if (cost < best.cost) best = {k, p, cost, left, right};
+      }
+    }
+    return best;
+  }
+
+  const KdPrimitives& prims_;
+  const KdTreeConfig& config_;
+  KdCost cost_;
+  int max_depth_;
+  ExactBuilder exact_;
+};
+
+// Builds the tree from the root's references. A root of at most
+// config.exact_below references: the exact build, on its own threads.
+// Otherwise the binned levels on this thread down to nodes of at most 1/16
+// of the references (at least kParallelMin), then those subtrees on
+// `threads` host threads, the largest first.
+std::unique_ptr<KdBuildNode> build_tree(const KdPrimitives& prims, const KdTreeConfig& config, int depth,
+                                        unsigned threads, std::vector<Ref> refs) {
+  auto root = std::make_unique<KdBuildNode>();
+  const std::size_t n = refs.size();
+  const double budget = kKdReferenceBudget * static_cast<double>(n);
+  if (n <= config.exact_below) {
+    ExactBuilder(prims, config, depth, threads).build(*root, prims.lower, prims.upper, refs, 0, budget);
+    return root;
+  }
+  std::vector<KdTask> tasks;
+  BinnedBuilder top(prims, config, depth);
+  if (threads < 2 || n < 2 * kParallelMin) {
+    top.build(*root, prims.lower, prims.upper, std::move(refs), 0, budget);
+    return root;
+  }
+  top.build(*root, prims.lower, prims.upper, std::move(refs), 0, budget, std::max(kParallelMin, n / 16), &tasks);
+  std::sort(tasks.begin(), tasks.end(), [](const KdTask& a, const KdTask& b) { return a.refs.size() > b.refs.size(); });
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    BinnedBuilder builder(prims, config, depth);
+    for (std::size_t i; (i = next.fetch_add(1)) < tasks.size();) {
+      KdTask& t = tasks[i];
+      builder.build(*t.node, t.lower, t.upper, std::move(t.refs), t.depth, t.budget);
+    }
+  };
+  std::vector<std::thread> workers;
+  for (unsigned t = 1; t < std::min<std::size_t>(threads, tasks.size()); ++t) workers.emplace_back(work);
+  work();
+  for (std::thread& w : workers) w.join();
+  return root;
+}
 
 void check_config(const KdTreeConfig& c) {
   if (c.depth < 0 || c.depth > kKdMaxDepth)
@@ -233,27 +518,15 @@ KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config) {
   KdPrimitives prims = kd_primitives(geometry, "kdtree", config.max_alloc_bytes);
   int depth = kdtree_depth(config, prims.size());
   unsigned threads = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
-  // The root's events from the primitives' own bounds (the root box holds
-  // them all), sorted once: every node below keeps its lists sorted.
-  Events events;
-  for (auto& list : events) list.reserve(2 * prims.size());
+  // The root's references: the primitives' own bounds (the root box holds
+  // them all).
+  std::vector<Ref> refs(prims.size());
   for (std::uint32_t i = 0; i < prims.size(); ++i) {
     glm::dvec3 lo, hi;
     prims.bounds(i, &lo, &hi);
-    add_events(events, i, lo, hi);
+    refs[i] = make_ref(i, lo, hi);
   }
-  if (threads > 1 && prims.size() >= kParallelMin) {
-    std::thread y([&] { std::sort(events[1].begin(), events[1].end()); });
-    std::sort(events[0].begin(), events[0].end());
-    std::sort(events[2].begin(), events[2].end());
-    y.join();
-  } else {
-    for (auto& list : events) std::sort(list.begin(), list.end());
-  }
-  KdBuilder builder(prims, config, depth, threads);
-  std::vector<std::uint8_t> side(prims.size(), 0);
-  auto root = builder.build(prims.lower, prims.upper, std::move(events), 0,
-                            kKdReferenceBudget * static_cast<double>(prims.size()), side);
+  auto root = build_tree(prims, config, depth, threads, std::move(refs));
   return flatten_kd_tree(prims, *root, "kdtree", "depth=" + std::to_string(depth), config.max_alloc_bytes);
 }
 
@@ -270,7 +543,10 @@ std::vector<OptionSpec> kdtree_options() {
           {"empty", OptionType::real, d.empty_bonus, 0, 0.99, false,
            "empty-space bonus: a split with one empty side costs (1 - empty) times its SAH cost"},
           {"batch", OptionType::integer, std::int64_t{d.batch}, 1, 8, false,
-           "primitives per intersection test in the SAH (1: classic; 8: the kernel's float8 batch, larger leaves)"}};
+           "primitives per intersection test in the SAH (1: classic; 8: the kernel's float8 batch, larger leaves)"},
+          {"exact", OptionType::integer, static_cast<std::int64_t>(d.exact_below), 0, 1073741824.0, false,
+           "nodes of at most this many references split by the exact sweep over sorted events, larger ones at 64 bin "
+           "boundaries per axis"}};
 }
 
 std::unique_ptr<Accel> make_kdtree_from(const StructureSpec& spec, KdTraversal traversal, const Device& device,
@@ -282,6 +558,7 @@ std::unique_ptr<Accel> make_kdtree_from(const StructureSpec& spec, KdTraversal t
   kd.intersection_cost = o.real("ci");
   kd.empty_bonus = o.real("empty");
   kd.batch = static_cast<unsigned>(o.integer("batch"));
+  kd.exact_below = static_cast<std::size_t>(o.integer("exact"));
   return make_kdtree(device, geometry, kd, config, spec.name, traversal);
 }
 

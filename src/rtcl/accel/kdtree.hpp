@@ -39,8 +39,15 @@ struct KdTreeConfig {
   // triangles cost the same, so 8 models it: larger leaves, a shallower
   // tree, fewer references, a faster build.
   unsigned batch = 8;
-  // Host threads (0 = hardware concurrency) for subtrees of nodes with at
-  // least 4096 primitives, and for sorting the root's events per axis.
+  // Subtrees of at most this many references are built by the exact
+  // sweep over sorted events (Wald & Havran 2006, O(N log N)); larger
+  // nodes are split by the same SAH at up to 64 bin boundaries per axis
+  // (min-max binning: linear, no sorting). 0: binned throughout (the
+  // default: the faster build, and its trees traced as fast or faster on
+  // the shared meshes, README "BSP and kd-tree"); 2^30: exact throughout.
+  std::size_t exact_below = 0;
+  // Host threads (0 = hardware concurrency) for the exact builds of the
+  // binned levels' nodes.
   unsigned thread_count = 0;
   // The largest buffer the device can allocate (0: no limit).
   std::size_t max_alloc_bytes = 0;

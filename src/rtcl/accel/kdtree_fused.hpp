@@ -25,21 +25,6 @@ namespace rtcl {
 // 7 (f - 1) + 8 = 7 f + 1.
 constexpr int kKdCellStack = 7 * kKdMaxDepth + 1;
 
-// A float box; empty() has lower +inf, upper -inf (a cell no ray enters).
-struct KdBox {
-  float lower[3], upper[3];
-  static KdBox empty() {
-    const float inf = std::numeric_limits<float>::infinity();
-    return {{inf, inf, inf}, {-inf, -inf, -inf}};
-  }
-  void grow(const KdBox& b) {
-    for (int a = 0; a < 3; ++a) {
-      lower[a] = std::min(lower[a], b.lower[a]);
-      upper[a] = std::max(upper[a], b.upper[a]);
-    }
-  }
-};
-
 // The fused nodes of `nodes` (depth-first, root first; the root box from
 // `header`); leaves stay in `nodes` and are referenced as ~index. A leaf's
 // lane holds leaf_bounds(leaf index, its kd cell): the box a hit in it can

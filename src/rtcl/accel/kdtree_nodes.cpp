@@ -32,11 +32,13 @@ constexpr std::size_t kLanePadding = RTCL_BLOCK_WIDTH;
 struct Flattener {
   const KdPrimitives& prims;
   KdTree& tree;
+  std::vector<const KdBuildNode*> leaves;  // by node index; null for inner nodes
 
   void emit(const KdBuildNode& node, std::uint32_t depth) {
     tree.depth = std::max(tree.depth, depth);
     std::size_t index = tree.nodes.size();
     tree.nodes.push_back({});
+    leaves.push_back(node.axis < 0 ? &node : nullptr);
     if (node.axis < 0) {
       // Triangles first, each kind ascending: prims are sorted indices and
       // every triangle index is below every sphere index.
@@ -149,7 +151,8 @@ KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const
     tree.header.lower[a] = static_cast<float>(prims.lower[a]);
     tree.header.upper[a] = static_cast<float>(prims.upper[a]);
   }
-  Flattener{prims, tree}.emit(root, 0);
+  Flattener flattener{prims, tree, {}};
+  flattener.emit(root, 0);
   std::string what = structure + " over " + prims.geometry->source;
   if (tree.depth > static_cast<std::uint32_t>(kKdMaxDepth))
     throw Error(what + ": " + option + ": the tree is deeper than the traversal stack's " +
@@ -163,6 +166,7 @@ KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const
   // A leaf's cell box shrunk to what its primitives clipped to the
   // (widened) cell cover, rounded outwards.
   tree.fused = fuse_kd_nodes(tree.nodes, tree.header, [&](std::size_t leaf, const KdBox& cell) {
+    if (flattener.leaves[leaf]->has_content) return flattener.leaves[leaf]->content;
     KdBox tight = KdBox::empty();
     glm::dvec3 lo(cell.lower[0], cell.lower[1], cell.lower[2]), hi(cell.upper[0], cell.upper[1], cell.upper[2]);
     const std::uint32_t first = tree.nodes[leaf].flags >> 2, count = tree.nodes[leaf].data;

@@ -7,10 +7,12 @@
 // depth; kdtree: the surface area heuristic).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -90,13 +92,33 @@ float kd_round_float(double x, bool down);
 // must fit in max_alloc_bytes (0: no limit), checked before any work.
 KdPrimitives kd_primitives(const Geometry& geometry, const std::string& structure, std::size_t max_alloc_bytes);
 
+// A float box; empty() has lower +inf, upper -inf (a cell no ray enters).
+struct KdBox {
+  float lower[3], upper[3];
+  static KdBox empty() {
+    const float inf = std::numeric_limits<float>::infinity();
+    return {{inf, inf, inf}, {-inf, -inf, -inf}};
+  }
+  void grow(const KdBox& b) {
+    for (int a = 0; a < 3; ++a) {
+      lower[a] = std::min(lower[a], b.lower[a]);
+      upper[a] = std::max(upper[a], b.upper[a]);
+    }
+  }
+};
+
 // A node of the build tree: inner (axis 0..2) with both children, or a leaf
-// (axis -1) listing primitive indices of KdPrimitives.
+// (axis -1) listing primitive indices of KdPrimitives. A builder that knows
+// the bounds of a leaf's primitives clipped to its (widened) cell, rounded
+// outwards, gives their union as `content` (has_content); flatten_kd_tree
+// clips them again otherwise.
 struct KdBuildNode {
   int axis = -1;
   float split = 0.0f;
   std::unique_ptr<KdBuildNode> below, above;
   std::vector<std::uint32_t> prims;
+  bool has_content = false;
+  KdBox content = KdBox::empty();
 };
 
 // Flattens the build tree into the device layout. Throws Error naming the

@@ -16,6 +16,9 @@ bool clip_triangle_bounds(const glm::dvec3& a, const glm::dvec3& b, const glm::d
       // Keep sign * (p[axis] - bound) >= 0.
       double bound = side == 0 ? lower[axis] : upper[axis];
       double sign = side == 0 ? 1.0 : -1.0;
+      bool inside = true;
+      for (int v = 0; v < n && inside; ++v) inside = sign * (poly[v][axis] - bound) >= 0.0;
+      if (inside) continue;  // the plane keeps the polygon as it is
       int m = 0;
       for (int v = 0; v < n; ++v) {
         const glm::dvec3 &p = poly[v], &q = poly[(v + 1) % n];
