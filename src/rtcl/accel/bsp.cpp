@@ -95,7 +95,7 @@ KdTree build_bsp(const Geometry& geometry, const BspConfig& config) {
                             kKdReferenceBudget * static_cast<double>(prims.size()));
   return flatten_kd_tree(prims, *root, "bsp",
                          "depth=" + std::to_string(depth) + ",leaf=" + std::to_string(config.leaf_size),
-                         config.max_alloc_bytes);
+                         config.max_alloc_bytes, threads);
 }
 
 const StructureSpec& bsp_structure() {

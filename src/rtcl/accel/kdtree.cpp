@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
+#include <condition_variable>
+#include <mutex>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <thread>
@@ -35,6 +39,19 @@ struct Ref {
   std::array<float, 3> lower, upper;
   std::uint32_t prim;
 };
+
+// Four floats in one vector register (GCC/Clang vector extensions), for
+// binning a bound's three coordinates at once.
+using Float4 = float __attribute__((vector_size(16)));
+using Int4 = std::int32_t __attribute__((vector_size(16)));
+
+// The four floats from xyz on: a Ref's lower or upper bound and the float
+// after it (lane 3, within the Ref either way).
+Float4 load4(const float* xyz) {
+  Float4 v;
+  std::memcpy(&v, xyz, sizeof v);
+  return v;
+}
 
 Ref make_ref(std::uint32_t prim, const glm::dvec3& lower, const glm::dvec3& upper) {
   Ref r;
@@ -73,29 +90,71 @@ struct KdTask {
   double budget;
 };
 
+// The subtrees the binned levels leave to workers (KdTask), handed out
+// largest first while the binned levels are still adding to them.
+class KdTaskQueue {
+ public:
+  void push(KdTask task) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      tasks_.push_back(std::move(task));
+    }
+    ready_.notify_one();
+  }
+
+  // No more tasks will come.
+  void close() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      closed_ = true;
+    }
+    ready_.notify_all();
+  }
+
+  // The largest waiting task; false once closed and empty.
+  bool pop(KdTask* task) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ready_.wait(lock, [&] { return !tasks_.empty() || closed_; });
+    if (tasks_.empty()) return false;
+    auto largest = std::max_element(tasks_.begin(), tasks_.end(), [](const KdTask& a, const KdTask& b) {
+      return a.refs.size() < b.refs.size();
+    });
+    *task = std::move(*largest);
+    tasks_.erase(largest);
+    return true;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::vector<KdTask> tasks_;
+  bool closed_ = false;
+};
+
+
 // The split cost and the leaf cost of the SAH (KdTreeConfig), shared by the
 // binned and the exact split.
 class KdCost {
  public:
-  explicit KdCost(const KdTreeConfig& config) : config_(config), per_batch_(1.0 / config.batch) {}
+  explicit KdCost(const KdTreeConfig& config)
+      : config_(config), shift_(std::has_single_bit(config.batch) ? std::countr_zero(config.batch) : -1) {}
 
   double leaf(std::size_t n) const { return config_.intersection_cost * tests(n); }
 
   // Intersection tests a leaf of n primitives costs: one per batch of
-  // config.batch (the kernel tests up to 8 at once in float8 lanes).
-  // ceil(n / batch) without an integer division or a call to floor (the
-  // sweeps evaluate it twice per candidate plane): the double quotient is
-  // at least 1/8 from the next integer below it, far beyond its rounding
-  // for n < 2^30, and truncation is floor for it.
+  // config.batch (the kernel tests up to 8 at once in float8 lanes), a
+  // shift for the batches of 1, 2, 4 and 8 (the sweeps evaluate it twice
+  // per candidate plane).
   double tests(std::size_t n) const {
-    return static_cast<double>(static_cast<std::uint64_t>(static_cast<double>(n + config_.batch - 1) * per_batch_));
+    std::size_t runs = n + config_.batch - 1;
+    return static_cast<double>(shift_ >= 0 ? runs >> shift_ : runs / config_.batch);
   }
 
   const KdTreeConfig& config() const { return config_; }
 
  private:
   const KdTreeConfig& config_;
-  double per_batch_;
+  int shift_;  // log2(batch) when batch is a power of two, else -1
 };
 
 // The SAH cost of the splits of one node's box [lower, upper].
@@ -340,7 +399,7 @@ class BinnedBuilder {
   // subtrees built later, on other threads). `budget`: the references the
   // subtree may list (kKdReferenceBudget).
   void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, std::vector<Ref> refs, int depth,
-             double budget, std::size_t defer_at = 0, std::vector<KdTask>* deferred = nullptr) {
+             double budget, std::size_t defer_at = 0, KdTaskQueue* deferred = nullptr) {
     const std::size_t n = refs.size();
     if (n <= config_.exact_below) {
       exact_.build(node, lower, upper, refs, depth, budget);
@@ -395,9 +454,9 @@ class BinnedBuilder {
 
  private:
   void child(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, std::vector<Ref> refs, int depth,
-             double budget, std::size_t defer_at, std::vector<KdTask>* deferred) {
+             double budget, std::size_t defer_at, KdTaskQueue* deferred) {
     if (deferred && refs.size() <= defer_at)
-      deferred->push_back({&node, lower, upper, std::move(refs), depth, budget});
+      deferred->push({&node, lower, upper, std::move(refs), depth, budget});
     else
       build(node, lower, upper, std::move(refs), depth, budget, defer_at, deferred);
   }
@@ -416,22 +475,28 @@ class BinnedBuilder {
     const int bins = static_cast<int>(std::clamp<std::size_t>(n, 8, kBins));
     std::array<std::array<std::uint32_t, kBins>, 3> starts, ends;
     glm::dvec3 extent = upper - lower;
-    std::array<float, 3> origin, to_bin;
+    Float4 origin{}, to_bin{};
     for (int k = 0; k < 3; ++k) {
       std::fill_n(starts[k].begin(), bins, 0u);
       std::fill_n(ends[k].begin(), bins, 0u);
       origin[k] = static_cast<float>(lower[k]);
       to_bin[k] = extent[k] > 0.0 ? static_cast<float>(bins / extent[k]) : 0.0f;
     }
-    const float last = static_cast<float>(bins - 1);
-    auto bin = [&](float x, int k) {
-      return static_cast<int>(std::min(std::max((x - origin[k]) * to_bin[k], 0.0f), last));
+    const Float4 zero{}, last = Float4{} + static_cast<float>(bins - 1);
+    // The bins of a bound's three coordinates at once (lane 3 unused).
+    auto bin = [&](const float* xyz) {
+      Float4 b = (load4(xyz) - origin) * to_bin;
+      b = b > zero ? b : zero;
+      b = b < last ? b : last;
+      return __builtin_convertvector(b, Int4);
     };
-    for (const Ref& r : refs)
+    for (const Ref& r : refs) {
+      Int4 s = bin(r.lower.data()), e = bin(r.upper.data());
       for (int k = 0; k < 3; ++k) {
-        ++starts[k][bin(r.lower[k], k)];
-        ++ends[k][bin(r.upper[k], k)];
+        ++starts[k][s[k]];
+        ++ends[k][e[k]];
       }
+    }
     for (int k = 0; k < 3; ++k) {
       if (!(extent[k] > 0.0)) continue;
       std::size_t left = 0, right = n;
@@ -457,9 +522,10 @@ class BinnedBuilder {
 
 // Builds the tree from the root's references. A root of at most
 // config.exact_below references: the exact build, on its own threads.
-// Otherwise the binned levels on this thread down to nodes of at most 1/16
-// of the references (at least kParallelMin), then those subtrees on
-// `threads` host threads, the largest first.
+// Otherwise this thread splits the binned levels down to nodes of at most
+// 1/16 of the references (at least kParallelMin) and queues those
+// subtrees, which `threads` - 1 workers build meanwhile; then it builds
+// queued subtrees too.
 std::unique_ptr<KdBuildNode> build_tree(const KdPrimitives& prims, const KdTreeConfig& config, int depth,
                                         unsigned threads, std::vector<Ref> refs) {
   auto root = std::make_unique<KdBuildNode>();
@@ -469,26 +535,26 @@ std::unique_ptr<KdBuildNode> build_tree(const KdPrimitives& prims, const KdTreeC
     ExactBuilder(prims, config, depth, threads).build(*root, prims.lower, prims.upper, refs, 0, budget);
     return root;
   }
-  std::vector<KdTask> tasks;
   BinnedBuilder top(prims, config, depth);
   if (threads < 2 || n < 2 * kParallelMin) {
     top.build(*root, prims.lower, prims.upper, std::move(refs), 0, budget);
     return root;
   }
-  top.build(*root, prims.lower, prims.upper, std::move(refs), 0, budget, std::max(kParallelMin, n / 16), &tasks);
-  std::sort(tasks.begin(), tasks.end(), [](const KdTask& a, const KdTask& b) { return a.refs.size() > b.refs.size(); });
-  std::atomic<std::size_t> next{0};
+  KdTaskQueue queue;
   auto work = [&] {
     BinnedBuilder builder(prims, config, depth);
-    for (std::size_t i; (i = next.fetch_add(1)) < tasks.size();) {
-      KdTask& t = tasks[i];
-      builder.build(*t.node, t.lower, t.upper, std::move(t.refs), t.depth, t.budget);
-    }
+    for (KdTask t; queue.pop(&t);) builder.build(*t.node, t.lower, t.upper, std::move(t.refs), t.depth, t.budget);
   };
-  std::vector<std::thread> workers;
-  for (unsigned t = 1; t < std::min<std::size_t>(threads, tasks.size()); ++t) workers.emplace_back(work);
+  std::vector<std::jthread> workers;
+  for (unsigned t = 1; t < threads; ++t) workers.emplace_back(work);
+  try {
+    top.build(*root, prims.lower, prims.upper, std::move(refs), 0, budget, std::max(kParallelMin, n / 16), &queue);
+  } catch (...) {
+    queue.close();
+    throw;
+  }
+  queue.close();
   work();
-  for (std::thread& w : workers) w.join();
   return root;
 }
 
@@ -527,7 +593,7 @@ KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config) {
     refs[i] = make_ref(i, lo, hi);
   }
   auto root = build_tree(prims, config, depth, threads, std::move(refs));
-  return flatten_kd_tree(prims, *root, "kdtree", "depth=" + std::to_string(depth), config.max_alloc_bytes);
+  return flatten_kd_tree(prims, *root, "kdtree", "depth=" + std::to_string(depth), config.max_alloc_bytes, threads);
 }
 
 namespace {

@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <thread>
 
 #include "rtcl/bounds/clip.hpp"
 #include "rtcl/error.hpp"
@@ -65,12 +66,7 @@ struct Flattener {
 
 }  // namespace
 
-float kd_round_float(double x, bool down) {
-  float f = static_cast<float>(x);
-  if (down && f > x) return std::nextafter(f, -std::numeric_limits<float>::infinity());
-  if (!down && f < x) return std::nextafter(f, std::numeric_limits<float>::infinity());
-  return f;
-}
+
 
 std::size_t KdTree::bytes() const {
   return sizeof(KdHeader) + nodes.size() * sizeof(KdNode) + fused.size() * sizeof(Bvh8Node) +
@@ -145,7 +141,7 @@ KdPrimitives kd_primitives(const Geometry& geometry, const std::string& structur
 }
 
 KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const std::string& structure,
-                       const std::string& option, std::size_t max_alloc_bytes) {
+                       const std::string& option, std::size_t max_alloc_bytes, unsigned threads) {
   KdTree tree;
   for (int a = 0; a < 3; ++a) {
     tree.header.lower[a] = static_cast<float>(prims.lower[a]);
@@ -165,7 +161,7 @@ KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const
               max_alloc_bytes);
   // A leaf's cell box shrunk to what its primitives clipped to the
   // (widened) cell cover, rounded outwards.
-  tree.fused = fuse_kd_nodes(tree.nodes, tree.header, [&](std::size_t leaf, const KdBox& cell) {
+  auto fuse = [&] { tree.fused = fuse_kd_nodes(tree.nodes, tree.header, [&](std::size_t leaf, const KdBox& cell) {
     if (flattener.leaves[leaf]->has_content) return flattener.leaves[leaf]->content;
     KdBox tight = KdBox::empty();
     glm::dvec3 lo(cell.lower[0], cell.lower[1], cell.lower[2]), hi(cell.upper[0], cell.upper[1], cell.upper[2]);
@@ -182,10 +178,12 @@ KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const
       }
     }
     return tight;
-  });
-  if (max_alloc_bytes && tree.fused.size() * sizeof(Bvh8Node) > max_alloc_bytes)
-    too_large(what, option, std::to_string(tree.fused.size()) + " fused nodes",
-              tree.fused.size() * sizeof(Bvh8Node), max_alloc_bytes);
+  }); };
+  // The fused nodes on a second thread while this one fills the reference
+  // lanes (neither writes what the other reads).
+  std::jthread fuser;
+  if (threads > 1) fuser = std::jthread(fuse);
+  else fuse();
   if (max_alloc_bytes && tree.refs.size() * sizeof(rtcl_i32) > max_alloc_bytes)
     too_large(what, option, std::to_string(tree.refs.size()) + " references", tree.refs.size() * sizeof(rtcl_i32),
               max_alloc_bytes);
@@ -209,6 +207,10 @@ KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const
       for (int a = 0; a < 3; ++a) tree.lanes[(3 * v + a) * stride + k] = b.v[v][a][r & 7];
     tree.lane_prims[k] = b.prim[r & 7];
   }
+  if (fuser.joinable()) fuser.join();
+  if (max_alloc_bytes && tree.fused.size() * sizeof(Bvh8Node) > max_alloc_bytes)
+    too_large(what, option, std::to_string(tree.fused.size()) + " fused nodes",
+              tree.fused.size() * sizeof(Bvh8Node), max_alloc_bytes);
   return tree;
 }
 

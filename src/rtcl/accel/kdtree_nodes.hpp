@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -83,8 +84,13 @@ struct KdPrimitives {
 };
 
 // x rounded to a float towards -inf (down) or +inf: float bounds that
-// enclose double ones.
-float kd_round_float(double x, bool down);
+// enclose double ones. Inline: the builds round six bounds per clip.
+inline float kd_round_float(double x, bool down) {
+  float f = static_cast<float>(x);
+  if (down && f > x) return std::nextafter(f, -std::numeric_limits<float>::infinity());
+  if (!down && f < x) return std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
 
 // The stored primitives of validated geometry and the root box: the scene
 // box padded by 16 float ulps of its magnitude and rounded outwards to
@@ -126,8 +132,9 @@ struct KdBuildNode {
 // deeper than kKdMaxDepth, when a node or reference index needs more than
 // 30 bits or the reference lanes more than 2^31 floats, or when nodes,
 // references or the reference lanes exceed max_alloc_bytes (0: none).
+// With threads > 1 the fused nodes are built on a second thread.
 KdTree flatten_kd_tree(const KdPrimitives& prims, const KdBuildNode& root, const std::string& structure,
-                       const std::string& option, std::size_t max_alloc_bytes);
+                       const std::string& option, std::size_t max_alloc_bytes, unsigned threads = 1);
 
 // Spare host threads for parallel subtree builds (as the BVH's builder).
 class KdThreads {

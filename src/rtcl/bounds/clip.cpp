@@ -8,7 +8,9 @@ bool clip_triangle_bounds(const glm::dvec3& a, const glm::dvec3& b, const glm::d
                           const glm::dvec3& upper, glm::dvec3* out_lower, glm::dvec3* out_upper) {
   // A convex polygon clipped by one plane gains at most one vertex: 3 + 6.
   constexpr int kMaxVertices = 9;
-  glm::dvec3 poly[kMaxVertices], next[kMaxVertices];
+  glm::dvec3 buffers[2][kMaxVertices];
+  glm::dvec3* poly = buffers[0];
+  glm::dvec3* next = buffers[1];
   poly[0] = a, poly[1] = b, poly[2] = c;
   int n = 3;
   for (int axis = 0; axis < 3; ++axis)
@@ -21,7 +23,7 @@ bool clip_triangle_bounds(const glm::dvec3& a, const glm::dvec3& b, const glm::d
       if (inside) continue;  // the plane keeps the polygon as it is
       int m = 0;
       for (int v = 0; v < n; ++v) {
-        const glm::dvec3 &p = poly[v], &q = poly[(v + 1) % n];
+        const glm::dvec3 &p = poly[v], &q = poly[v + 1 == n ? 0 : v + 1];
         double dp = sign * (p[axis] - bound), dq = sign * (q[axis] - bound);
         if (dp >= 0.0) next[m++] = p;
         if ((dp >= 0.0) != (dq >= 0.0) && m < kMaxVertices) {
@@ -32,7 +34,7 @@ bool clip_triangle_bounds(const glm::dvec3& a, const glm::dvec3& b, const glm::d
       }
       n = m;
       if (n == 0) return false;
-      std::copy(next, next + n, poly);
+      std::swap(poly, next);
     }
   glm::dvec3 lo = poly[0], hi = poly[0];
   for (int v = 1; v < n; ++v) {
