@@ -19,7 +19,8 @@ std::vector<Ray> split_plane_rays(const KdTree& tree, std::uint32_t seed, std::s
 
 // `accel` and brute force answer both queries identically: for closest hit
 // the same hit / miss and t (bit for bit unless `level` is fast, where the
-// programs may round differently: within 1e-5 relative), for any hit the
+// programs may round differently: within 1e-5 relative, or 16 float ulps of
+// the scene's scale along the ray), for any hit the
 // same hit / miss. The primitive may differ only on an exact tie of t
 // (triangles sharing the edge or vertex hit): with `judge`, robust answers
 // are judged against the double-precision reference, which accepts such a
