@@ -228,7 +228,7 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
                          "empty=0.8", "exact=64", "exact=1073741824", "batch=4,ct=20,exact=1073741824"})
     specs.push_back(std::string("kdtree:") + ct);
   for (const char* o : {"depth=14", "depth=18", "depth=22", "depth=26", "leaf=2", "leaf=12"}) specs.push_back(std::string("bsp:") + o);
-  for (RayKind kind : {RayKind::primary, RayKind::diffuse})
+  for (RayKind kind : {RayKind::primary, RayKind::shadow, RayKind::diffuse})
     for (const std::string& accel : specs) {
       std::string name = accel;
       name[name.find(':')] = '/';

@@ -461,8 +461,9 @@ class BinnedBuilder {
       build(node, lower, upper, std::move(refs), depth, budget, defer_at, deferred);
   }
 
-  // Planes at the bin boundaries strictly inside the node (as many bins as
-  // references, from 8 to kBins): N_below counts the references whose
+  // Planes at the bin boundaries strictly inside the node (a bin per two
+  // references, from 8 to kBins; a bin per reference built 12% slower
+  // trees that traced the same, README "BSP and kd-tree"): N_below counts the references whose
   // lower bound lies in a bin below the plane, N_above those whose upper
   // bound lies in a bin above it (both upper bounds of what the split
   // lists). Axis -1 when no plane beats a leaf.
@@ -472,7 +473,7 @@ class BinnedBuilder {
     best.cost = cost_.leaf(n);
     KdSplitCost split_cost(cost_, lower, upper);
     if (!split_cost.valid()) return best;
-    const int bins = static_cast<int>(std::clamp<std::size_t>(n, 8, kBins));
+    const int bins = static_cast<int>(std::clamp<std::size_t>(n / 2, 8, kBins));
     std::array<std::array<std::uint32_t, kBins>, 3> starts, ends;
     glm::dvec3 extent = upper - lower;
     Float4 origin{}, to_bin{};

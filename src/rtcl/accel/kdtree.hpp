@@ -22,12 +22,11 @@ struct KdTreeConfig {
   //   traversal_cost + intersection_cost * (SA_L / SA * N_L + SA_R / SA * N_R),
   // times (1 - empty_bonus) when one side is empty; a leaf costs
   // intersection_cost * N, and a node whose best split costs more is a leaf.
-  // Only the ratio of the two costs matters (Mitsuba uses 15 and 20). With
-  // batch = 8 (below), 15 was the best of 10, 15 and 20 on the primary rays
-  // of the bunny, sponza and sibenik (README, "BSP and kd-tree": bench
-  // sweep/<scene>/<kind>/kdtree/ct=...); with batch = 1 (sweep
-  // .../kdtree/batch=1,ct=...), 30 was the best of 10..120 on the bunny's.
-  double traversal_cost = 15.0;
+  // Only the ratio of the two costs matters (Mitsuba uses 15 and 20). The
+  // defaults (batch 4, 30) were the fastest to build among the settings
+  // that traced best on the bunny, sponza and sibenik with the binned
+  // build (README, "BSP and kd-tree": bench sweep/<scene>/<kind>/kdtree/...).
+  double traversal_cost = 30.0;
   double intersection_cost = 20.0;
   // The empty-space bonus in [0, 1) (Wald & Havran's 0.8 factor = 0.2):
   // favours splits that cut off empty space, which the interval traversal
@@ -36,9 +35,10 @@ struct KdTreeConfig {
   // Primitives one intersection test covers in the cost model, 1..8: 1 is
   // the classic SAH (cost per primitive); the kernel tests a leaf's
   // contiguous reference lanes in runs of 8 float8 lanes, where 1 and 8
-  // triangles cost the same, so 8 models it: larger leaves, a shallower
-  // tree, fewer references, a faster build.
-  unsigned batch = 8;
+  // triangles cost the same, so 8 models the tests alone: larger leaves, a
+  // shallower tree, fewer references, a faster build. 4 with ct = 30 traced
+  // faster than 8 with ct = 15 at the same build time.
+  unsigned batch = 4;
   // Subtrees of at most this many references are built by the exact
   // sweep over sorted events (Wald & Havran 2006, O(N log N)); larger
   // nodes are split by the same SAH at up to 64 bin boundaries per axis
