@@ -205,6 +205,12 @@ std::uint8_t side_of(float lower, float upper, float p) {
   return static_cast<std::uint8_t>((lower < p ? kBelow : 0) | (upper > p ? kAbove : 0));
 }
 
+// A node is a leaf when no split beats it, or when the split would list
+// more references than the subtree's budget.
+bool is_leaf(const Split& split, double budget) {
+  return split.axis < 0 || static_cast<double>(split.n_below + split.n_above) > budget;
+}
+
 // The leaf of `node` listing `prims` (sorted), with the union of their
 // clipped bounds.
 void make_leaf(KdBuildNode& node, std::vector<std::uint32_t> prims, const KdBox& content) {
@@ -264,10 +270,7 @@ class ExactBuilder {
     for (const Event& e : events[0]) n += e.type != kEnd;
     Split split;
     if (depth < max_depth_ && n > 0) split = find_split(lower, upper, events, n);
-    const int k = split.axis;
-    const float p = split.pos;
-    double both = static_cast<double>(split.n_below + split.n_above);
-    if (k < 0 || both > budget) {
+    if (is_leaf(split, budget)) {
       std::vector<std::uint32_t> prims;
       prims.reserve(n);
       for (const Event& e : events[0])
@@ -280,6 +283,9 @@ class ExactBuilder {
       make_leaf(node, std::move(prims), content);
       return;
     }
+    const int k = split.axis;
+    const float p = split.pos;
+    const double both = static_cast<double>(split.n_below + split.n_above);
     node.axis = k;
     node.split = p;
     // Sides, as the sweep counted them (side_of).
@@ -407,10 +413,7 @@ class BinnedBuilder {
     }
     Split split;
     if (depth < max_depth_) split = find_split(lower, upper, refs);
-    const int k = split.axis;
-    const float p = split.pos;
-    double both = static_cast<double>(split.n_below + split.n_above);
-    if (k < 0 || both > budget) {
+    if (is_leaf(split, budget)) {
       std::vector<std::uint32_t> prims;
       prims.reserve(n);
       KdBox content = KdBox::empty();
@@ -421,6 +424,9 @@ class BinnedBuilder {
       make_leaf(node, std::move(prims), content);
       return;
     }
+    const int k = split.axis;
+    const float p = split.pos;
+    const double both = static_cast<double>(split.n_below + split.n_above);
     node.axis = k;
     node.split = p;
     glm::dvec3 below_upper = upper, above_lower = lower;
