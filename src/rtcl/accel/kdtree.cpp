@@ -80,14 +80,22 @@ constexpr int kBins = 64;
 // Primitive sides during one split (bit 0: below, bit 1: above).
 enum Side : std::uint8_t { kBelow = 1, kAbove = 2, kBoth = 3 };
 
+// Where a node stands on its path from the root: its depth, the splits
+// above it that cost more than a leaf (is_leaf), and the references its
+// subtree may list (its share of kKdReferenceBudget).
+struct KdPath {
+  int depth = 0;
+  int costly_splits = 0;
+  double budget = 0.0;
+};
+
 // A subtree left to a worker thread: its root's placeholder in the tree,
-// box and references, and where it stands in depth and reference budget.
+// box and references, and its path.
 struct KdTask {
   KdBuildNode* node;
   glm::dvec3 lower, upper;
   std::vector<Ref> refs;
-  int depth;
-  double budget;
+  KdPath path;
 };
 
 // The subtrees the binned levels leave to workers (KdTask), handed out
@@ -205,10 +213,33 @@ std::uint8_t side_of(float lower, float upper, float p) {
   return static_cast<std::uint8_t>((lower < p ? kBelow : 0) | (upper > p ? kAbove : 0));
 }
 
-// A node is a leaf when no split beats it, or when the split would list
-// more references than the subtree's budget.
-bool is_leaf(const Split& split, double budget) {
-  return split.axis < 0 || static_cast<double>(split.n_below + split.n_above) > budget;
+// A node of more references than four runs of eight lanes splits even
+// when its best split costs more than the leaf, at most kCostlySplits
+// times on a path (after pbrt's "bad refines", Pharr et al., pbrt-v3
+// section 4.4): the SAH alone left the Cornell box in one leaf, its walls
+// spanning every plane, and the rays testing every triangle (0.70x the
+// BVH's primary rays; 0.82x with the split). A bound of 16 split 38% more
+// nodes of the bunny and built sponza 1.3x longer.
+constexpr std::size_t kLargeLeaf = 32;
+constexpr int kCostlySplits = 2;
+
+// Whether a node of n references at `path` is a leaf: no split, a split
+// beyond the subtree's budget, or one that costs more than the leaf
+// (unless the node is large, the split leaves fewer references on one
+// side and the path has taken fewer than kCostlySplits such splits).
+bool is_leaf(const Split& split, double leaf_cost, std::size_t n, const KdPath& path) {
+  if (split.axis < 0 || static_cast<double>(split.n_below + split.n_above) > path.budget) return true;
+  if (split.cost < leaf_cost) return false;
+  return n <= kLargeLeaf || std::min(split.n_below, split.n_above) >= n || path.costly_splits >= kCostlySplits;
+}
+
+// The children's paths: their shares of the budget from the split's counts
+// (upper bounds of what the clipping keeps).
+std::array<KdPath, 2> child_paths(const KdPath& path, const Split& split, double leaf_cost) {
+  const double both = static_cast<double>(split.n_below + split.n_above);
+  const int costly = path.costly_splits + (split.cost >= leaf_cost ? 1 : 0);
+  return {KdPath{path.depth + 1, costly, path.budget * static_cast<double>(split.n_below) / both},
+          KdPath{path.depth + 1, costly, path.budget * static_cast<double>(split.n_above) / both}};
 }
 
 // The leaf of `node` listing `prims` (sorted), with the union of their
@@ -232,7 +263,7 @@ class ExactBuilder {
       : prims_(prims), cost_(config), max_depth_(max_depth), threads_(static_cast<int>(threads) - 1) {}
 
   void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, const std::vector<Ref>& refs,
-             int depth, double budget) {
+             const KdPath& path) {
     Events events;
     for (auto& list : events) list.reserve(2 * refs.size());
     for (const Ref& r : refs) add_events(events, r);
@@ -246,7 +277,7 @@ class ExactBuilder {
       for (auto& list : events) std::sort(list.begin(), list.end());
     }
     if (side_.empty()) side_.assign(prims_.size(), 0);
-    build(node, lower, upper, std::move(events), depth, budget, side_);
+    build(node, lower, upper, std::move(events), path, side_);
   }
 
  private:
@@ -264,13 +295,14 @@ class ExactBuilder {
   }
 
   // `side`: all zero, one entry per primitive, this thread's.
-  void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, Events events, int depth,
-             double budget, std::vector<std::uint8_t>& side) {
+  void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, Events events,
+             const KdPath& path, std::vector<std::uint8_t>& side) {
     std::size_t n = 0;
     for (const Event& e : events[0]) n += e.type != kEnd;
     Split split;
-    if (depth < max_depth_ && n > 0) split = find_split(lower, upper, events, n);
-    if (is_leaf(split, budget)) {
+    if (path.depth < max_depth_ && n > 0) split = find_split(lower, upper, events, n);
+    const double leaf_cost = cost_.leaf(n);
+    if (is_leaf(split, leaf_cost, n, path)) {
       std::vector<std::uint32_t> prims;
       prims.reserve(n);
       for (const Event& e : events[0])
@@ -285,7 +317,6 @@ class ExactBuilder {
     }
     const int k = split.axis;
     const float p = split.pos;
-    const double both = static_cast<double>(split.n_below + split.n_above);
     node.axis = k;
     node.split = p;
     // Sides, as the sweep counted them (side_of).
@@ -325,23 +356,20 @@ class ExactBuilder {
     }
     below_new = {};
     above_new = {};
-    // The children's shares of the budget, from the sweep's counts (upper
-    // bounds of what the clipping keeps).
-    double below_budget = budget * static_cast<double>(split.n_below) / both;
-    double above_budget = budget * static_cast<double>(split.n_above) / both;
+    const auto [below_path, above_path] = child_paths(path, split, leaf_cost);
     node.below = std::make_unique<KdBuildNode>();
     node.above = std::make_unique<KdBuildNode>();
     if (n >= kParallelMin && threads_.try_take()) {
       std::thread worker([&] {
         std::vector<std::uint8_t> own(prims_.size(), 0);
-        build(*node.below, lower, below_upper, std::move(below), depth + 1, below_budget, own);
+        build(*node.below, lower, below_upper, std::move(below), below_path, own);
       });
-      build(*node.above, above_lower, upper, std::move(above), depth + 1, above_budget, side);
+      build(*node.above, above_lower, upper, std::move(above), above_path, side);
       worker.join();
       threads_.give_back();
     } else {
-      build(*node.below, lower, below_upper, std::move(below), depth + 1, below_budget, side);
-      build(*node.above, above_lower, upper, std::move(above), depth + 1, above_budget, side);
+      build(*node.below, lower, below_upper, std::move(below), below_path, side);
+      build(*node.above, above_lower, upper, std::move(above), above_path, side);
     }
   }
 
@@ -359,7 +387,7 @@ class ExactBuilder {
   // build lists them on both). Axis -1 when no split beats a leaf.
   Split find_split(const glm::dvec3& lower, const glm::dvec3& upper, const Events& events, std::size_t n) const {
     Split best;
-    best.cost = cost_.leaf(n);
+    best.cost = std::numeric_limits<double>::infinity();
     KdSplitCost split_cost(cost_, lower, upper);
     if (!split_cost.valid()) return best;
     for (int k = 0; k < 3; ++k) {
@@ -402,18 +430,18 @@ class BinnedBuilder {
 
   // Builds the subtree of `node`; with `deferred`, nodes of at most
   // `defer_at` references below this one are left there instead (their
-  // subtrees built later, on other threads). `budget`: the references the
-  // subtree may list (kKdReferenceBudget).
-  void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, std::vector<Ref> refs, int depth,
-             double budget, std::size_t defer_at = 0, KdTaskQueue* deferred = nullptr) {
+  // subtrees built later, on other threads).
+  void build(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, std::vector<Ref> refs,
+             const KdPath& path, std::size_t defer_at = 0, KdTaskQueue* deferred = nullptr) {
     const std::size_t n = refs.size();
     if (n <= config_.exact_below) {
-      exact_.build(node, lower, upper, refs, depth, budget);
+      exact_.build(node, lower, upper, refs, path);
       return;
     }
     Split split;
-    if (depth < max_depth_) split = find_split(lower, upper, refs);
-    if (is_leaf(split, budget)) {
+    if (path.depth < max_depth_) split = find_split(lower, upper, refs);
+    const double leaf_cost = cost_.leaf(n);
+    if (is_leaf(split, leaf_cost, n, path)) {
       std::vector<std::uint32_t> prims;
       prims.reserve(n);
       KdBox content = KdBox::empty();
@@ -426,7 +454,6 @@ class BinnedBuilder {
     }
     const int k = split.axis;
     const float p = split.pos;
-    const double both = static_cast<double>(split.n_below + split.n_above);
     node.axis = k;
     node.split = p;
     glm::dvec3 below_upper = upper, above_lower = lower;
@@ -448,23 +475,20 @@ class BinnedBuilder {
       }
     }
     refs = {};
-    // The children's shares of the budget, from the split's counts (upper
-    // bounds of what the clipping keeps).
+    const auto [below_path, above_path] = child_paths(path, split, leaf_cost);
     node.below = std::make_unique<KdBuildNode>();
     node.above = std::make_unique<KdBuildNode>();
-    child(*node.below, lower, below_upper, std::move(below), depth + 1,
-          budget * static_cast<double>(split.n_below) / both, defer_at, deferred);
-    child(*node.above, above_lower, upper, std::move(above), depth + 1,
-          budget * static_cast<double>(split.n_above) / both, defer_at, deferred);
+    child(*node.below, lower, below_upper, std::move(below), below_path, defer_at, deferred);
+    child(*node.above, above_lower, upper, std::move(above), above_path, defer_at, deferred);
   }
 
  private:
-  void child(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, std::vector<Ref> refs, int depth,
-             double budget, std::size_t defer_at, KdTaskQueue* deferred) {
+  void child(KdBuildNode& node, const glm::dvec3& lower, const glm::dvec3& upper, std::vector<Ref> refs,
+             const KdPath& path, std::size_t defer_at, KdTaskQueue* deferred) {
     if (deferred && refs.size() <= defer_at)
-      deferred->push({&node, lower, upper, std::move(refs), depth, budget});
+      deferred->push({&node, lower, upper, std::move(refs), path});
     else
-      build(node, lower, upper, std::move(refs), depth, budget, defer_at, deferred);
+      build(node, lower, upper, std::move(refs), path, defer_at, deferred);
   }
 
   // Planes at the bin boundaries strictly inside the node (a bin per two
@@ -476,7 +500,7 @@ class BinnedBuilder {
   Split find_split(const glm::dvec3& lower, const glm::dvec3& upper, const std::vector<Ref>& refs) const {
     const std::size_t n = refs.size();
     Split best;
-    best.cost = cost_.leaf(n);
+    best.cost = std::numeric_limits<double>::infinity();
     KdSplitCost split_cost(cost_, lower, upper);
     if (!split_cost.valid()) return best;
     const int bins = static_cast<int>(std::clamp<std::size_t>(n / 2, 8, kBins));
@@ -537,25 +561,25 @@ std::unique_ptr<KdBuildNode> build_tree(const KdPrimitives& prims, const KdTreeC
                                         unsigned threads, std::vector<Ref> refs) {
   auto root = std::make_unique<KdBuildNode>();
   const std::size_t n = refs.size();
-  const double budget = kKdReferenceBudget * static_cast<double>(n);
+  const KdPath path{0, 0, kKdReferenceBudget * static_cast<double>(n)};
   if (n <= config.exact_below) {
-    ExactBuilder(prims, config, depth, threads).build(*root, prims.lower, prims.upper, refs, 0, budget);
+    ExactBuilder(prims, config, depth, threads).build(*root, prims.lower, prims.upper, refs, path);
     return root;
   }
   BinnedBuilder top(prims, config, depth);
   if (threads < 2 || n < 2 * kParallelMin) {
-    top.build(*root, prims.lower, prims.upper, std::move(refs), 0, budget);
+    top.build(*root, prims.lower, prims.upper, std::move(refs), path);
     return root;
   }
   KdTaskQueue queue;
   auto work = [&] {
     BinnedBuilder builder(prims, config, depth);
-    for (KdTask t; queue.pop(&t);) builder.build(*t.node, t.lower, t.upper, std::move(t.refs), t.depth, t.budget);
+    for (KdTask t; queue.pop(&t);) builder.build(*t.node, t.lower, t.upper, std::move(t.refs), t.path);
   };
   std::vector<std::jthread> workers;
   for (unsigned t = 1; t < threads; ++t) workers.emplace_back(work);
   try {
-    top.build(*root, prims.lower, prims.upper, std::move(refs), 0, budget, std::max(kParallelMin, n / 16), &queue);
+    top.build(*root, prims.lower, prims.upper, std::move(refs), path, std::max(kParallelMin, n / 16), &queue);
   } catch (...) {
     queue.close();
     throw;
