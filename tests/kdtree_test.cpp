@@ -82,6 +82,21 @@ TEST(KdBuild, SahCutsOffEmptySpaceAndStopsWhenNoSplitPays) {
   EXPECT_LT(build_kdtree(soup).references_per_primitive(), build_bsp(soup).references_per_primitive());
 }
 
+// A room whose walls span every plane: no split costs less than one leaf
+// of all its triangles, but a node of more than 32 references still splits
+// (up to two such splits on a path), and the tree traces as brute force.
+TEST(KdBuild, ARoomOfWallsIsSplitThoughNoSplitBeatsItsLeaf) {
+  Geometry g = load_mesh(scene_path("cornell_box/CornellBox-Original.obj")).geometry;
+  validate(g);
+  ASSERT_GT(g.triangles.size(), 32u);
+  KdTree t = build_kdtree(g);
+  EXPECT_NE(t.nodes[0].flags & 3u, RTCL_KD_LEAF);
+  std::vector<Ray> rays = random_rays(g, 600, 31);
+  std::vector<Ray> planes = split_plane_rays(t, 32, 600);
+  rays.insert(rays.end(), planes.begin(), planes.end());
+  expect_same_as_brute(*make_kdtree(test_device(), g), g, rays, Precision::robust);
+}
+
 // The build's threads change nothing in the tree: the binned levels hand
 // whole subtrees to workers, and the exact build's subtrees do not depend
 // on which thread builds them.
