@@ -177,7 +177,8 @@ RTCL_TRIANGLE_LANES_INLINE int intersect_triangle_lanes(float8 ax, float8 ay, fl
 
 /* A block of eight triangles (v[vertex][axis][lane] rows: row 3*vertex+axis).
  * Always inlined where the kernel defines RTCL_INLINE_TRIANGLE_BLOCK (the
- * BVH, kernels/accel/bvh.cl; the octrees measured 2-7% slower with it). */
+ * BVH, kernels/accel/bvh.cl; the octrees measured up to 10% slower with
+ * it). */
 #ifdef RTCL_INLINE_TRIANGLE_BLOCK
 RTCL_LANES_INLINE
 #else
