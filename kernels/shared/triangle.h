@@ -88,8 +88,8 @@ RTCL_LANES_INLINE Watertight8 rtcl_watertight_edges8(float8 ax, float8 ay, float
  * (barycentrics V / det, W / det). */
 RTCL_LANES_INLINE int8 rtcl_watertight_hit8(const Watertight8* w, float8 sz, float8 tmin, float8 t_best,
                                             float8* t, float8* det) {
-  int8 inside = ((w->U >= 0.0f) & (w->V >= 0.0f) & (w->W >= 0.0f)) |
-                ((w->U <= 0.0f) & (w->V <= 0.0f) & (w->W <= 0.0f));
+  int8 inside = (rtcl_fmin8(w->U, rtcl_fmin8(w->V, w->W)) >= 0.0f) |
+                (rtcl_fmax8(w->U, rtcl_fmax8(w->V, w->W)) <= 0.0f);
   *det = w->U + w->V + w->W;
   float8 T = sz * (w->U * w->Az + w->V * w->Bz + w->W * w->Cz);
   *t = T / *det;
@@ -163,7 +163,9 @@ RTCL_TRIANGLE_LANES_INLINE int intersect_triangle_lanes(float8 ax, float8 ay, fl
   int8 ok = rtcl_watertight_hit8(&w, (float8)(s->sz), (float8)(s->tmin), (float8)(h->t_best), &t, &det);
   if (!rtcl_any8(ok)) return 0;
   float8 t_ok = select((float8)(INFINITY), t, ok);
-  float m = rtcl_min8(t_ok);
+  float4 m4 = select(t_ok.hi, t_ok.lo, t_ok.lo < t_ok.hi);
+  float2 m2 = select(m4.hi, m4.lo, m4.lo < m4.hi);
+  float m = m2.x < m2.y ? m2.x : m2.y;
   int lane = rtcl_lane_of(t_ok, m);
   float inv_det = 1.0f / rtcl_lane(det, lane);
   h->t_best = m;
