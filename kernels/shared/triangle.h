@@ -88,6 +88,7 @@ RTCL_LANES_INLINE Watertight8 rtcl_watertight_edges8(float8 ax, float8 ay, float
  * (barycentrics V / det, W / det). */
 RTCL_LANES_INLINE int8 rtcl_watertight_hit8(const Watertight8* w, float8 sz, float8 tmin, float8 t_best,
                                             float8* t, float8* det) {
+  /* a lane with a NaN edge may pass; its det and t are NaN and fail the t test */
   int8 inside = (rtcl_fmin8(w->U, rtcl_fmin8(w->V, w->W)) >= 0.0f) |
                 (rtcl_fmax8(w->U, rtcl_fmax8(w->V, w->W)) <= 0.0f);
   *det = w->U + w->V + w->W;
