@@ -19,7 +19,9 @@
 inline float8 rtcl_edge8(float8 a, float8 b, float8 c, float8 d) {
   float8 e = a * d - b * c;
 #if defined(RTCL_HAS_FP64) && defined(RTCL_PRECISION_ROBUST)
-  if (any(e == 0.0f)) {
+  /* rtcl_any8, not any(): PoCL turns any() into a test and branch per
+   * lane (measured: 1.02-1.07x the BVH's rays/s, README "Results") */
+  if (rtcl_any8(e == 0.0f)) {
     /* two double4 halves: double8 is not a native vector type on AVX2 */
     double4 lo = convert_double4(a.lo) * convert_double4(d.lo) - convert_double4(b.lo) * convert_double4(c.lo);
     double4 hi = convert_double4(a.hi) * convert_double4(d.hi) - convert_double4(b.hi) * convert_double4(c.hi);
@@ -86,8 +88,9 @@ RTCL_LANES_INLINE Watertight8 rtcl_watertight_edges8(float8 ax, float8 ay, float
  * (barycentrics V / det, W / det). */
 RTCL_LANES_INLINE int8 rtcl_watertight_hit8(const Watertight8* w, float8 sz, float8 tmin, float8 t_best,
                                             float8* t, float8* det) {
-  int8 inside = ((w->U >= 0.0f) & (w->V >= 0.0f) & (w->W >= 0.0f)) |
-                ((w->U <= 0.0f) & (w->V <= 0.0f) & (w->W <= 0.0f));
+  /* a lane with a NaN edge may pass; its det and t are NaN and fail the t test */
+  int8 inside = (rtcl_fmin8(w->U, rtcl_fmin8(w->V, w->W)) >= 0.0f) |
+                (rtcl_fmax8(w->U, rtcl_fmax8(w->V, w->W)) <= 0.0f);
   *det = w->U + w->V + w->W;
   float8 T = sz * (w->U * w->Az + w->V * w->Bz + w->W * w->Cz);
   *t = T / *det;
@@ -161,7 +164,9 @@ RTCL_TRIANGLE_LANES_INLINE int intersect_triangle_lanes(float8 ax, float8 ay, fl
   int8 ok = rtcl_watertight_hit8(&w, (float8)(s->sz), (float8)(s->tmin), (float8)(h->t_best), &t, &det);
   if (!rtcl_any8(ok)) return 0;
   float8 t_ok = select((float8)(INFINITY), t, ok);
-  float m = rtcl_min8(t_ok);
+  float4 m4 = select(t_ok.hi, t_ok.lo, t_ok.lo < t_ok.hi);
+  float2 m2 = select(m4.hi, m4.lo, m4.lo < m4.hi);
+  float m = m2.x < m2.y ? m2.x : m2.y;
   int lane = rtcl_lane_of(t_ok, m);
   float inv_det = 1.0f / rtcl_lane(det, lane);
   h->t_best = m;
@@ -173,8 +178,16 @@ RTCL_TRIANGLE_LANES_INLINE int intersect_triangle_lanes(float8 ax, float8 ay, fl
 #endif
 }
 
-/* A block of eight triangles (v[vertex][axis][lane] rows: row 3*vertex+axis). */
-inline int intersect_triangles8(global const TriangleBlock* block, const TraceRay* s, HitState* h) {
+/* A block of eight triangles (v[vertex][axis][lane] rows: row 3*vertex+axis).
+ * Always inlined where the kernel defines RTCL_INLINE_TRIANGLE_BLOCK (the
+ * BVH, kernels/accel/bvh.cl; the octrees measured up to 10% slower with
+ * it). */
+#ifdef RTCL_INLINE_TRIANGLE_BLOCK
+RTCL_LANES_INLINE
+#else
+inline
+#endif
+int intersect_triangles8(global const TriangleBlock* block, const TraceRay* s, HitState* h) {
   global const float* v = &block->v[0][0][0];
   return intersect_triangle_lanes(vload8(s->kx, v), vload8(s->ky, v), vload8(s->kz, v), vload8(3 + s->kx, v),
                                   vload8(3 + s->ky, v), vload8(3 + s->kz, v), vload8(6 + s->kx, v),

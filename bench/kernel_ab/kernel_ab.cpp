@@ -1,0 +1,196 @@
+// rtcl_kernel_ab: two or more versions of the kernels/ tree timed against
+// each other in one process, launch by launch, on the bench/ scenes' rays.
+//
+//   rtcl_kernel_ab SCENES ROUNDS KERNEL_DIR...
+//   e.g. rtcl_kernel_ab bunny,sponza,sibenik 15 /tmp/kernels-before kernels
+//
+// Each KERNEL_DIR is a copy of kernels/ (RTCL_KERNEL_DIR is set to it while
+// its structure's programs are built; programs are cached by source, so the
+// versions never share one). Per scene (bench/ camera and light, image side
+// $RTCL_BENCH_RES, default 512) it traces the primary rays and the shadow and
+// diffuse rays spawned from the first version's primary hits, as bench/
+// does. Per ray set: one launch per version whose hits are compared with the
+// first version's, bit for bit (a line "DIFFERS" names the rays that are
+// not); then ROUNDS rounds of one launch per version, the order rotated each
+// round, and one Embree rtcIntersect1 / rtcOccluded1 trace of the same rays
+// on all hardware threads when built with Embree (the bench/ framing:
+// traversal only). Prints per version the median and fastest kernel time
+// (OpenCL events), its ratio to the first version (> 1: faster) and to
+// Embree (rtcl rays/s over Embree's). Versions measured in one process and
+// alternating see the same machine: on shared, drifting machines their
+// ratios hold where separate runs' do not.
+//
+// Environment: AB_ACCEL (structure, default bvh), AB_NO_EMBREE (set: no
+// Embree), RTCL_BENCH_RES, RTCL_SCENES_DIR, RTCL_DEVICE.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rtcl/accel/accel.hpp"
+#include "rtcl/bench/ray_sets.hpp"
+#include "rtcl/bench/scene_catalog.hpp"
+#include "rtcl/cl/device.hpp"
+#include "rtcl/error.hpp"
+#include "rtcl/scene/geometry.hpp"
+#include "rtcl/scene/mesh_io.hpp"
+#include "rtcl/scene/procedural.hpp"
+#ifdef RTCL_HAVE_EMBREE
+#include "rtcl/bench/embree_baseline.hpp"
+#endif
+
+namespace {
+
+using namespace rtcl;
+using namespace rtcl::bench;
+
+// Waits for e, then returns its kernel time.
+double kernel_ms(const cl::Event& e) {
+  e.wait();
+  return static_cast<double>(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                             e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+         1e-6;
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+double fastest(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+
+std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+int run(int argc, char** argv) {
+  if (argc < 4) {
+    std::fprintf(stderr, "usage: rtcl_kernel_ab SCENES ROUNDS KERNEL_DIR...  (e.g. bunny,sponza 15 old/ kernels/)\n");
+    return 2;
+  }
+  const std::vector<std::string> scenes = split(argv[1]);
+  const int rounds = std::atoi(argv[2]);
+  if (rounds < 1) throw Error(std::string("ROUNDS must be a positive number, not '") + argv[2] + "'");
+  const std::vector<std::string> versions(argv + 3, argv + argc);
+  const char* accel_env = std::getenv("AB_ACCEL");
+  const std::string accel_name = accel_env && *accel_env ? accel_env : "bvh";
+  const char* res_env = std::getenv("RTCL_BENCH_RES");
+  const int res = res_env && *res_env ? std::atoi(res_env) : 512;
+  if (res < 1) throw Error("RTCL_BENCH_RES must be a positive number");
+  const char* dir_env = std::getenv("RTCL_SCENES_DIR");
+  const std::string scenes_dir = dir_env && *dir_env ? dir_env : RTCL_KERNEL_AB_SCENES_DIR;
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+#ifdef RTCL_HAVE_EMBREE
+  const bool use_embree = std::getenv("AB_NO_EMBREE") == nullptr;
+#endif
+
+  Device device = Device::open();
+  for (const std::string& scene_name : scenes) {
+    const SceneSpec* spec = find_scene_spec(scene_name);
+    if (!spec || spec->fit)
+      throw Error("scene '" + scene_name +
+                  "': not a bench/ scene with a fixed camera (bunny, dragon, sponza, sibenik, teapot-stadium)");
+    Geometry geometry = load_mesh(scenes_dir + "/" + spec->file).geometry;
+    if (spec->stadium > 0.0f) add_stadium(geometry, spec->stadium);
+    validate(geometry);
+
+    std::vector<std::unique_ptr<Accel>> accels;
+    for (const std::string& dir : versions) {
+      setenv("RTCL_KERNEL_DIR", dir.c_str(), 1);
+      accels.push_back(make_accel(device, accel_name, geometry));
+    }
+    // One launch of version v over `rays`; its hits into *hits when given.
+    auto launch = [&](std::size_t v, Query query, const std::vector<Ray>& rays, std::vector<Hit>* hits) {
+      setenv("RTCL_KERNEL_DIR", versions[v].c_str(), 1);
+      cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), "rays");
+      cl::Buffer hit_buffer = device.allocate(rays.size() * sizeof(Hit), "hits");
+      accels[v]->trace(query, ray_buffer, hit_buffer, rays.size()).wait();
+      hits->resize(rays.size());
+      device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, rays.size() * sizeof(Hit), hits->data());
+    };
+
+    std::vector<Ray> primary = primary_rays(spec->camera, res, res);
+    std::vector<Hit> primary_hits;
+    launch(0, Query::closest, primary, &primary_hits);
+    SecondaryRays secondary = secondary_rays(geometry, primary, primary_hits, spec->light);
+    struct Set {
+      const char* name;
+      Query query;
+      const std::vector<Ray>* rays;
+    };
+    const Set sets[] = {{"primary", Query::closest, &primary},
+                        {"shadow", Query::any, &secondary.shadow},
+                        {"diffuse", Query::closest, &secondary.diffuse}};
+#ifdef RTCL_HAVE_EMBREE
+    std::unique_ptr<EmbreeScene> embree;
+    if (use_embree) embree = std::make_unique<EmbreeScene>(geometry, EmbreeQuality::standard, threads);
+#endif
+    for (const Set& set : sets) {
+      const std::vector<Ray>& rays = *set.rays;
+      std::vector<Hit> first, other;
+      launch(0, set.query, rays, &first);
+      for (std::size_t v = 1; v < versions.size(); ++v) {
+        launch(v, set.query, rays, &other);
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) differ += std::memcmp(&first[i], &other[i], sizeof(Hit)) != 0;
+        if (differ)
+          std::printf("DIFFERS %s %s: version %zu on %zu of %zu rays\n", scene_name.c_str(), set.name, v, differ,
+                      rays.size());
+      }
+      cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), "rays");
+      cl::Buffer hit_buffer = device.allocate(rays.size() * sizeof(Hit), "hits");
+      std::vector<std::vector<double>> ms(versions.size());
+      std::vector<double> embree_ms;
+      for (int r = 0; r < rounds; ++r) {
+        for (std::size_t j = 0; j < versions.size(); ++j) {
+          std::size_t v = (j + static_cast<std::size_t>(r)) % versions.size();
+          ms[v].push_back(kernel_ms(accels[v]->trace(set.query, ray_buffer, hit_buffer, rays.size())));
+        }
+#ifdef RTCL_HAVE_EMBREE
+        if (embree) {
+          embree->prepare(set.query, rays.data(), rays.size());
+          auto start = std::chrono::steady_clock::now();
+          embree->trace_prepared(threads);
+          embree_ms.push_back(
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        }
+#endif
+      }
+      std::printf("%-8s %-8s %8zu rays |", scene_name.c_str(), set.name, rays.size());
+      for (std::size_t v = 0; v < versions.size(); ++v) {
+        std::printf(" v%zu %7.2f / %7.2f ms", v, median(ms[v]), fastest(ms[v]));
+        if (v) std::printf(" (x%.3f / x%.3f)", median(ms[0]) / median(ms[v]), fastest(ms[0]) / fastest(ms[v]));
+        if (!embree_ms.empty())
+          std::printf(" E %.3f / %.3f", median(embree_ms) / median(ms[v]), fastest(embree_ms) / fastest(ms[v]));
+        std::printf(" |");
+      }
+      if (!embree_ms.empty()) std::printf(" embree %7.2f / %7.2f ms", median(embree_ms), fastest(embree_ms));
+      std::printf("\n");
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "rtcl_kernel_ab: %s\n", e.what());
+    return 1;
+  }
+}
