@@ -71,7 +71,7 @@ struct Split {
 };
 
 // Nodes of at least this many references may be built on another thread.
-constexpr std::size_t kParallelMin = 4096;
+constexpr std::size_t kParallelMin = 1024;
 
 // Candidate planes per axis of a binned split: the boundaries of this many
 // equal bins over the node box.
