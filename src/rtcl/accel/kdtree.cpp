@@ -213,24 +213,29 @@ std::uint8_t side_of(float lower, float upper, float p) {
   return static_cast<std::uint8_t>((lower < p ? kBelow : 0) | (upper > p ? kAbove : 0));
 }
 
-// A node of more references than four runs of eight lanes splits even
-// when its best split costs more than the leaf, at most kCostlySplits
-// times on a path (after pbrt's "bad refines", Pharr et al., pbrt-v3
-// section 4.4): the SAH alone left the Cornell box in one leaf, its walls
-// spanning every plane, and the rays testing every triangle (0.70x the
-// BVH's primary rays; 0.82x with the split). A bound of 16 split 38% more
-// nodes of the bunny and built sponza 1.3x longer.
-constexpr std::size_t kLargeLeaf = 32;
+// A large node splits even when its best split costs more than its leaf,
+// at most kCostlySplits times on a path (after pbrt's "bad refines",
+// Pharr et al., pbrt-v3 section 4.4). Large: more than one run of eight
+// lanes, and more than four runs or an eighth of the scene's references.
+// The SAH alone left the Cornell box's 36 triangles in one leaf, its walls
+// spanning every plane, and every ray testing all of them. Forcing splits
+// of every node above one run built sponza 1.7x longer (README "BSP and
+// kd-tree").
+constexpr std::size_t kRun = 8;
+constexpr std::size_t kLargeLeaf = 4 * kRun;
 constexpr int kCostlySplits = 2;
 
-// Whether a node of n references at `path` is a leaf: no split, a split
-// beyond the subtree's budget, or one that costs more than the leaf
-// (unless the node is large, the split leaves fewer references on one
-// side and the path has taken fewer than kCostlySplits such splits).
-bool is_leaf(const Split& split, double leaf_cost, std::size_t n, const KdPath& path) {
+bool is_large(std::size_t n, std::size_t scene) { return n > kRun && (n > kLargeLeaf || 8 * n > scene); }
+
+// Whether a node of n references (of `scene` stored primitives) at `path`
+// is a leaf: no split, a split beyond the subtree's budget, or one that
+// costs more than the leaf (unless the node is large, the split leaves
+// fewer references on one side and the path has taken fewer than
+// kCostlySplits such splits).
+bool is_leaf(const Split& split, double leaf_cost, std::size_t n, std::size_t scene, const KdPath& path) {
   if (split.axis < 0 || static_cast<double>(split.n_below + split.n_above) > path.budget) return true;
   if (split.cost < leaf_cost) return false;
-  return n <= kLargeLeaf || std::min(split.n_below, split.n_above) >= n || path.costly_splits >= kCostlySplits;
+  return !is_large(n, scene) || std::min(split.n_below, split.n_above) >= n || path.costly_splits >= kCostlySplits;
 }
 
 // The children's paths: their shares of the budget from the split's counts
@@ -302,7 +307,7 @@ class ExactBuilder {
     Split split;
     if (path.depth < max_depth_ && n > 0) split = find_split(lower, upper, events, n);
     const double leaf_cost = cost_.leaf(n);
-    if (is_leaf(split, leaf_cost, n, path)) {
+    if (is_leaf(split, leaf_cost, n, prims_.size(), path)) {
       std::vector<std::uint32_t> prims;
       prims.reserve(n);
       for (const Event& e : events[0])
@@ -441,7 +446,7 @@ class BinnedBuilder {
     Split split;
     if (path.depth < max_depth_) split = find_split(lower, upper, refs);
     const double leaf_cost = cost_.leaf(n);
-    if (is_leaf(split, leaf_cost, n, path)) {
+    if (is_leaf(split, leaf_cost, n, prims_.size(), path)) {
       std::vector<std::uint32_t> prims;
       prims.reserve(n);
       KdBox content = KdBox::empty();
