@@ -53,6 +53,35 @@ KdTreeConfig exact_below(std::size_t n) {
   return c;
 }
 
+// Clipping to both children at once (the parent clip shared) gives what
+// clipping to each child gives, to the rounding of double.
+TEST(KdClip, SplitClipsAgreeWithClippingToEachChild) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.0, 2.0);
+  const glm::dvec3 lower(0.0), upper(1.0);
+  for (int i = 0; i < 2000; ++i) {
+    glm::dvec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng)), c(u(rng), u(rng), u(rng));
+    int axis = i % 3;
+    double p = 0.5 * (u(rng) + 1.0) / 1.5;
+    ClipSplit split = clip_triangle_split(a, b, c, lower, upper, axis, p, p);
+    glm::dvec3 below_upper = upper, above_lower = lower, lo, hi;
+    below_upper[axis] = p;
+    above_lower[axis] = p;
+    bool below = clip_triangle_bounds(a, b, c, lower, below_upper, &lo, &hi);
+    ASSERT_EQ(split.below, below) << i;
+    for (int k = 0; below && k < 3; ++k) {
+      EXPECT_NEAR(split.below_lower[k], lo[k], 1e-12) << i;
+      EXPECT_NEAR(split.below_upper[k], hi[k], 1e-12) << i;
+    }
+    bool above = clip_triangle_bounds(a, b, c, above_lower, upper, &lo, &hi);
+    ASSERT_EQ(split.above, above) << i;
+    for (int k = 0; above && k < 3; ++k) {
+      EXPECT_NEAR(split.above_lower[k], lo[k], 1e-12) << i;
+      EXPECT_NEAR(split.above_upper[k], hi[k], 1e-12) << i;
+    }
+  }
+}
+
 TEST(KdBuild, SahCutsOffEmptySpaceAndStopsWhenNoSplitPays) {
   // Two clusters far apart: the first split separates them, whether the
   // root is split at bin boundaries or by the exact sweep.

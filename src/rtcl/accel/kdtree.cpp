@@ -346,12 +346,14 @@ class ExactBuilder {
         else if (side[e.prim] == kAbove) above[a].push_back(e);
       }
     }
-    glm::dvec3 cl, cu;
+    std::array<bool, 2> reaches;
+    std::array<glm::dvec3, 2> cl, cu;
     for (const Event& e : events[k]) {
       if (e.type == kEnd) continue;
       if (side[e.prim] == kBoth) {
-        if (prims_.clip(e.prim, lower, below_upper, &cl, &cu)) add_events(below_new, make_ref(e.prim, cl, cu));
-        if (prims_.clip(e.prim, above_lower, upper, &cl, &cu)) add_events(above_new, make_ref(e.prim, cl, cu));
+        prims_.clip_split(e.prim, lower, upper, k, p, &reaches, &cl, &cu);
+        if (reaches[0]) add_events(below_new, make_ref(e.prim, cl[0], cu[0]));
+        if (reaches[1]) add_events(above_new, make_ref(e.prim, cl[1], cu[1]));
       }
       side[e.prim] = 0;
     }
@@ -468,7 +470,8 @@ class BinnedBuilder {
     std::vector<Ref> below, above;
     below.reserve(split.n_below);
     above.reserve(split.n_above);
-    glm::dvec3 cl, cu;
+    std::array<bool, 2> reaches;
+    std::array<glm::dvec3, 2> cl, cu;
     for (const Ref& r : refs) {
       std::uint8_t side = side_of(r.lower[k], r.upper[k], p);
       if (side == kBelow) {
@@ -476,8 +479,9 @@ class BinnedBuilder {
       } else if (side == kAbove) {
         above.push_back(r);
       } else {
-        if (prims_.clip(r.prim, lower, below_upper, &cl, &cu)) below.push_back(make_ref(r.prim, cl, cu));
-        if (prims_.clip(r.prim, above_lower, upper, &cl, &cu)) above.push_back(make_ref(r.prim, cl, cu));
+        prims_.clip_split(r.prim, lower, upper, k, p, &reaches, &cl, &cu);
+        if (reaches[0]) below.push_back(make_ref(r.prim, cl[0], cu[0]));
+        if (reaches[1]) above.push_back(make_ref(r.prim, cl[1], cu[1]));
       }
     }
     refs = {};

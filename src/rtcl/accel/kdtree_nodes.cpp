@@ -116,6 +116,27 @@ bool KdPrimitives::clip(std::uint32_t i, const glm::dvec3& box_lower, const glm:
   return true;
 }
 
+void KdPrimitives::clip_split(std::uint32_t i, const glm::dvec3& box_lower, const glm::dvec3& box_upper, int axis,
+                              double p, std::array<bool, 2>* reaches, std::array<glm::dvec3, 2>* clipped_lower,
+                              std::array<glm::dvec3, 2>* clipped_upper) const {
+  if (i >= triangle_count) {
+    glm::dvec3 below_upper = box_upper, above_lower = box_lower;
+    below_upper[axis] = p;
+    above_lower[axis] = p;
+    (*reaches)[0] = clip(i, box_lower, below_upper, &(*clipped_lower)[0], &(*clipped_upper)[0]);
+    (*reaches)[1] = clip(i, above_lower, box_upper, &(*clipped_lower)[1], &(*clipped_upper)[1]);
+    return;
+  }
+  const Geometry& g = *geometry;
+  const glm::uvec3& t = g.triangles[ids[i]];
+  ClipSplit c = clip_triangle_split(glm::dvec3(g.vertices[t.x]), glm::dvec3(g.vertices[t.y]),
+                                    glm::dvec3(g.vertices[t.z]), box_lower - widen, box_upper + widen, axis,
+                                    p + widen, p - widen);
+  *reaches = {c.below, c.above};
+  *clipped_lower = {c.below_lower, c.above_lower};
+  *clipped_upper = {c.below_upper, c.above_upper};
+}
+
 KdPrimitives kd_primitives(const Geometry& geometry, const std::string& structure, std::size_t max_alloc_bytes) {
   KdPrimitives p;
   p.geometry = &geometry;

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstddef>
@@ -81,6 +82,12 @@ struct KdPrimitives {
             glm::dvec3* clipped_upper) const;
   // Its bounds without clipping.
   void bounds(std::uint32_t i, glm::dvec3* lower, glm::dvec3* upper) const;
+  // clip() to both children of [lower, upper] split at p on `axis` at once
+  // (clip_triangle_split: the parent clip shared): bounds[0] below, [1]
+  // above; reaches[k] false when the primitive does not reach child k.
+  void clip_split(std::uint32_t i, const glm::dvec3& lower, const glm::dvec3& upper, int axis, double p,
+                  std::array<bool, 2>* reaches, std::array<glm::dvec3, 2>* clipped_lower,
+                  std::array<glm::dvec3, 2>* clipped_upper) const;
 };
 
 // x rounded to a float towards -inf (down) or +inf: float bounds that
