@@ -7,8 +7,9 @@
 //     with that option (lambda=..., res=AxBxC, macro=...): the lecture's
 //     trade-off of cell count against list length, and the macrocell size
 //     (bench/plot_sweep.py plots it)
-//   sweep/<scene>/<kind>/kdtree/[batch=<b>,]ct=<value>, sweep/<scene>/<kind>/bsp/<option>=<value>
-//     the kd-tree's SAH traversal cost, the BSP's depth and leaf size
+//   sweep/<scene>/<kind>/kdtree/<options>, sweep/<scene>/<kind>/bsp/<option>=<value>
+//     the kd-tree's SAH costs, empty-space bonus and exact build; the BSP's
+//     depth and leaf size
 // Kernel time comes from OpenCL event profiling (COMMAND_START .. COMMAND_END)
 // and is reported as manual time; a warm-up launch first absorbs PoCL's
 // compile-on-first-launch. Brute force traces a subset (brute_ray_limit()).

@@ -4,11 +4,11 @@
 #include <array>
 #include <atomic>
 #include <bit>
-#include <condition_variable>
-#include <mutex>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -70,8 +70,12 @@ struct Split {
   std::size_t n_below = 0, n_above = 0;  // primitives each side lists
 };
 
-// Nodes of at least this many references may be built on another thread.
+// Binned subtrees of at least this many references may be queued to
+// another thread.
 constexpr std::size_t kParallelMin = 1024;
+// The exact build hands a subtree of at least this many references to a
+// spare thread, which allocates its own side per primitive.
+constexpr std::size_t kExactParallelMin = 4096;
 
 // Candidate planes per axis of a binned split: the boundaries of this many
 // equal bins over the node box.
@@ -138,7 +142,6 @@ class KdTaskQueue {
   std::vector<KdTask> tasks_;
   bool closed_ = false;
 };
-
 
 // The split cost and the leaf cost of the SAH (KdTreeConfig), shared by the
 // binned and the exact split.
@@ -216,7 +219,7 @@ std::uint8_t side_of(float lower, float upper, float p) {
 // A large node splits even when its best split costs more than its leaf,
 // at most kCostlySplits times on a path (after pbrt's "bad refines",
 // Pharr et al., pbrt-v3 section 4.4). Large: more than one run of eight
-// lanes, and more than four runs or an eighth of the scene's references.
+// lanes, and more than four runs or an eighth of the scene's primitives.
 // The SAH alone left the Cornell box's 36 triangles in one leaf, its walls
 // spanning every plane, and every ray testing all of them: 0.58-0.68x the
 // BVH's primary rays, 0.88-0.91x with up to three such splits (0.81x with
@@ -262,7 +265,7 @@ void make_leaf(KdBuildNode& node, std::vector<std::uint32_t> prims, const KdBox&
 // event position of a node, the children's lists filtered from the
 // parent's (keeping them sorted) and merged with the re-sorted events of
 // the straddling primitives clipped to each child. Subtrees of at least
-// kParallelMin references go to spare host threads.
+// kExactParallelMin references go to spare host threads.
 class ExactBuilder {
  public:
   ExactBuilder(const KdPrimitives& prims, const KdTreeConfig& config, int max_depth, unsigned threads)
@@ -273,7 +276,7 @@ class ExactBuilder {
     Events events;
     for (auto& list : events) list.reserve(2 * refs.size());
     for (const Ref& r : refs) add_events(events, r);
-    if (refs.size() >= kParallelMin && threads_.try_take()) {
+    if (refs.size() >= kExactParallelMin && threads_.try_take()) {
       std::thread y([&] { std::sort(events[1].begin(), events[1].end()); });
       std::sort(events[0].begin(), events[0].end());
       std::sort(events[2].begin(), events[2].end());
@@ -367,7 +370,7 @@ class ExactBuilder {
     const auto [below_path, above_path] = child_paths(path, split, leaf_cost);
     node.below = std::make_unique<KdBuildNode>();
     node.above = std::make_unique<KdBuildNode>();
-    if (n >= kParallelMin && threads_.try_take()) {
+    if (n >= kExactParallelMin && threads_.try_take()) {
       std::thread worker([&] {
         std::vector<std::uint8_t> own(prims_.size(), 0);
         build(*node.below, lower, below_upper, std::move(below), below_path, own);
@@ -502,11 +505,11 @@ class BinnedBuilder {
   }
 
   // Planes at the bin boundaries strictly inside the node (a bin per two
-  // references, from 8 to kBins; a bin per reference built 12% slower
-  // trees that traced the same, README "BSP and kd-tree"): N_below counts the references whose
-  // lower bound lies in a bin below the plane, N_above those whose upper
-  // bound lies in a bin above it (both upper bounds of what the split
-  // lists). Axis -1 when no plane beats a leaf.
+  // references, from 8 to kBins; a bin per reference built sponza's tree
+  // 7-12% slower and traced the same, README "BSP and kd-tree"): N_below
+  // counts the references whose lower bound lies in a bin below the plane,
+  // N_above those whose upper bound lies in a bin above it (both upper
+  // bounds of what the split lists). Axis -1 when no plane beats a leaf.
   Split find_split(const glm::dvec3& lower, const glm::dvec3& upper, const std::vector<Ref>& refs) const {
     const std::size_t n = refs.size();
     Split best;

@@ -1,8 +1,9 @@
 // SAH kd-tree (Havran 2000; Wald & Havran 2006, "On building fast kd-trees
 // for ray tracing, and on doing that in O(N log N)"): the BSP's nodes with
-// the split plane placed freely, chosen by the surface area heuristic over
-// the sorted boundary events of the node's primitives, whose bounds are
-// those of the triangles clipped to the node box ("perfect splits"). Same
+// the split plane placed freely, chosen by the surface area heuristic at
+// bin boundaries (min-max binning) or over the sorted boundary events of
+// the node's primitives (KdTreeConfig::exact_below), whose bounds are those
+// of the triangles clipped to the node box ("perfect splits"). Same
 // nodes and traversal as the BSP (kdtree_nodes.hpp, kernels/accel/kdtree.cl).
 #pragma once
 
@@ -46,8 +47,9 @@ struct KdTreeConfig {
   // default: the faster build, and its trees traced as fast or faster on
   // the shared meshes, README "BSP and kd-tree"); 2^30: exact throughout.
   std::size_t exact_below = 0;
-  // Host threads (0 = hardware concurrency) for the exact builds of the
-  // binned levels' nodes.
+  // Host threads (0 = hardware concurrency): the subtrees the binned levels
+  // queue, the exact build's large subtrees, and the fused nodes beside the
+  // reference lanes.
   unsigned thread_count = 0;
   // The largest buffer the device can allocate (0: no limit).
   std::size_t max_alloc_bytes = 0;
