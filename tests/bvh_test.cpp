@@ -319,6 +319,38 @@ void expect_real_mesh_matches(const char* file) {
   }
 }
 
+// The tree in a canonical form: depth first, each node's box, then a leaf's
+// primitive ids or an inner node's children; node numbering left out.
+void canonical(const BuildTree& tree, std::uint32_t n, std::vector<double>& out) {
+  const BuildNode& node = tree.nodes[n];
+  for (int a = 0; a < 3; ++a) {
+    out.push_back(node.bounds.lower[a]);
+    out.push_back(node.bounds.upper[a]);
+  }
+  out.push_back(node.count);
+  if (node.is_leaf()) {
+    for (std::uint32_t k = node.first; k < node.first + node.count; ++k) out.push_back(tree.prims[k]);
+    return;
+  }
+  for (std::uint32_t c : node.child) canonical(tree, c, out);
+}
+
+// The subtrees built on other threads and the ranges binned by two threads
+// (at 16384 references and more) give the tree of the one-thread build.
+TEST(Bvh, SahTreeDoesNotDependOnTheThreads) {
+  Geometry g = random_soup(60000, 5);
+  Inputs in = triangle_inputs(g);
+  std::vector<double> one, many;
+  canonical(build_sah(in.bounds, in.ids, {.thread_count = 1}), 0, one);
+  for (unsigned threads : {2u, 4u}) {
+    BuildTree tree = build_sah(in.bounds, in.ids, {.thread_count = threads});
+    EXPECT_EQ(check(tree, in.bounds, in.ids, 8), "") << threads << " threads";
+    many.clear();
+    canonical(tree, 0, many);
+    EXPECT_TRUE(one == many) << threads << " threads";
+  }
+}
+
 TEST(Bvh, MatchesReferenceOnBunny) { expect_real_mesh_matches("stanford_bunny/bunny.obj"); }
 TEST(Bvh, MatchesReferenceOnDragon) { expect_real_mesh_matches("stanford_dragon_100k/dragon.obj"); }
 TEST(Bvh, MatchesReferenceOnSponza) { expect_real_mesh_matches("sponza/sponza.obj"); }

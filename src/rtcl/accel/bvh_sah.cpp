@@ -4,7 +4,10 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <condition_variable>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -17,6 +20,10 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr std::uint32_t kMaxBins = 256;
+// Ranges binned with two sets of bins (bin_range), and by two threads when
+// one is idle (find_split).
+constexpr std::uint32_t kTwoSetMin = 1024;
+constexpr std::uint32_t kParallelBinMin = 16384;
 
 // Four floats in one SIMD register (GCC/Clang vector extension): x, y, z
 // and a spare lane. Boxes grow with two 4-wide min/max operations.
@@ -66,12 +73,18 @@ struct PrimRef {
 
 inline float blocks(std::uint32_t n) { return static_cast<float>((n + RTCL_BLOCK_WIDTH - 1) / RTCL_BLOCK_WIDTH); }
 
+// The bins of a centre: bins_of(centre, offset, scale, last_bin), count
+// bins per axis.
+struct BinMap {
+  Float4 offset = {0, 0, 0, 0}, scale = {0, 0, 0, 0}, last_bin = {0, 0, 0, 0};
+  std::uint32_t count = 0;
+};
+
 struct Split {
   int axis = -1;          // -1: no plane separates the centroids
   std::uint32_t bin = 0;  // left side: bins [0, bin)
   float cost = kInf;      // area-weighted, in block tests
-  // bins of centre c (bins_of), per axis
-  Float4 offset = {0, 0, 0, 0}, scale = {0, 0, 0, 0}, last_bin = {0, 0, 0, 0};
+  BinMap map;             // the bins of a centre
   Box left = Box::empty(), right = Box::empty();
 };
 
@@ -84,6 +97,34 @@ inline Int4 bins_of(Float4 centre, Float4 offset, Float4 scale, Float4 last_bin)
   k = min4(k, last_bin);
   return __builtin_convertvector(k, Int4);
 }
+
+// Per axis and bin: the bounds of the references whose centre falls in it,
+// and their number. Trivially constructible: clear() the bins in use.
+struct Bins {
+  Box box[3][kMaxBins];
+  std::uint32_t count[3][kMaxBins];
+
+  void clear(std::uint32_t bins) {
+    for (int a = 0; a < 3; ++a)
+      for (std::uint32_t k = 0; k < bins; ++k) {
+        box[a][k] = Box::empty();
+        count[a][k] = 0;
+      }
+  }
+  void add(Int4 k, const Box& b) {
+    for (int a = 0; a < 3; ++a) {
+      box[a][k[a]].grow(b);
+      ++count[a][k[a]];
+    }
+  }
+  void merge(const Bins& other, std::uint32_t bins) {
+    for (int a = 0; a < 3; ++a)
+      for (std::uint32_t k = 0; k < bins; ++k) {
+        box[a][k].grow(other.box[a][k]);
+        count[a][k] += other.count[a][k];
+      }
+  }
+};
 
 // A node's primitives: refs[begin, end), their bounds and their centres'.
 struct Range {
@@ -100,8 +141,8 @@ class SahBuilder {
       refs_[i].box = {Float4{b.lower.x, b.lower.y, b.lower.z, 0.0f},
                       Float4{b.upper.x, b.upper.y, b.upper.z, std::bit_cast<float>(ids[i])}};
     }
-    unsigned threads = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
-    spare_threads_ = static_cast<int>(threads) - 1;
+    thread_count_ = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
+    if (refs_.size() < 2 * config.parallel_min_primitives) thread_count_ = 1;
   }
 
   BuildTree run() {
@@ -112,7 +153,11 @@ class SahBuilder {
       all.bounds.grow(r.box);
       all.centres.grow_point(r.centre());
     }
-    build(0, all, 1);
+    tasks_.push_back({0, all, 1});
+    std::vector<std::thread> helpers;
+    for (unsigned t = 1; t < thread_count_; ++t) helpers.emplace_back([this] { work(); });
+    work();
+    for (std::thread& helper : helpers) helper.join();
     nodes_.resize(node_count_.load());
     tree.nodes = std::move(nodes_);
     tree.prims.resize(refs_.size());
@@ -121,39 +166,40 @@ class SahBuilder {
   }
 
  private:
-  // Best SAH plane over bins of the centroids in the range. Nodes below
-  // 32 * bin_count primitives use n / 32 bins, at least 16: a node's cost is
-  // O(n + bins), and the bins that matter are those of the large nodes near
-  // the root. Not inlined: its ~20 KB of bins must not sit in every frame of
-  // the recursion.
+  // Best SAH plane over bins of the centroids in the range. Nodes use n / 8
+  // bins, at least 8 and at most bin_count: a node's cost is O(n + bins),
+  // and the bins that matter are those of the large nodes near the root.
+  // Not inlined: its bins (~28 KB a set) must not sit in every frame of the
+  // recursion.
   [[gnu::noinline]] Split find_split(const Range& range) const {
     const std::uint32_t n = range.end - range.begin;
-    const std::uint32_t k_count = std::min(config_.bin_count, std::max(16u, n / 32));
-    Box bin_box[3][kMaxBins];
-    std::uint32_t bin_n[3][kMaxBins];
-    Float4 offset = {0, 0, 0, 0}, scale = {0, 0, 0, 0};
-    const auto last = static_cast<float>(k_count - 1);
-    const Float4 last_bin = {last, last, last, last};
+    BinMap map;
+    map.count = std::min(config_.bin_count, std::max(8u, n / 8));
+    const auto last = static_cast<float>(map.count - 1);
+    map.last_bin = Float4{last, last, last, last};
     bool usable[3];
     for (int a = 0; a < 3; ++a) {
-      for (std::uint32_t k = 0; k < k_count; ++k) {
-        bin_box[a][k] = Box::empty();
-        bin_n[a][k] = 0;
-      }
       float extent = range.centres.hi[a] - range.centres.lo[a];
-      offset[a] = range.centres.lo[a];
-      float sc = static_cast<float>(k_count) * (1.0f - 4.0f * std::numeric_limits<float>::epsilon()) / extent;
+      map.offset[a] = range.centres.lo[a];
+      float sc = static_cast<float>(map.count) * (1.0f - 4.0f * std::numeric_limits<float>::epsilon()) / extent;
       usable[a] = extent > 0.0f && std::isfinite(extent) && std::isfinite(sc) && sc > 0.0f;
-      scale[a] = usable[a] ? sc : 0.0f;
+      map.scale[a] = usable[a] ? sc : 0.0f;
     }
-    for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      const PrimRef& r = refs_[i];
-      Int4 k = bins_of(r.centre(), offset, scale, last_bin);
-      for (int a = 0; a < 3; ++a) {
-        bin_box[a][k[a]].grow(r.box);
-        ++bin_n[a][k[a]];
-      }
+    Bins bins;
+    bins.clear(map.count);
+    if (n >= kParallelBinMin && idle_threads_.load(std::memory_order_relaxed) > 0) {
+      // a thread is waiting for work: it bins the second half
+      std::uint32_t mid = range.begin + n / 2;
+      std::unique_ptr<Bins> second = std::make_unique<Bins>();
+      second->clear(map.count);
+      std::thread helper([&] { bin_range(mid, range.end, map, *second); });
+      bin_range(range.begin, mid, map, bins);
+      helper.join();
+      bins.merge(*second, map.count);
+    } else {
+      bin_range(range.begin, range.end, map, bins);
     }
+    const std::uint32_t k_count = map.count;
     Split best;
     float right_area[kMaxBins];
     std::uint32_t right_n[kMaxBins];
@@ -162,16 +208,16 @@ class SahBuilder {
       Box acc = Box::empty();
       std::uint32_t count = 0;
       for (std::uint32_t k = k_count - 1; k > 0; --k) {
-        acc.grow(bin_box[a][k]);
-        count += bin_n[a][k];
+        acc.grow(bins.box[a][k]);
+        count += bins.count[a][k];
         right_area[k] = acc.area();
         right_n[k] = count;
       }
       acc = Box::empty();
       count = 0;
       for (std::uint32_t k = 1; k < k_count; ++k) {
-        acc.grow(bin_box[a][k - 1]);
-        count += bin_n[a][k - 1];
+        acc.grow(bins.box[a][k - 1]);
+        count += bins.count[a][k - 1];
         if (count == 0 || right_n[k] == 0) continue;
         float cost = acc.area() * blocks(count) + right_area[k] * blocks(right_n[k]);
         if (cost < best.cost) {
@@ -183,12 +229,27 @@ class SahBuilder {
     }
     if (best.axis >= 0) {
       int a = best.axis;
-      best.offset = offset;
-      best.scale = scale;
-      best.last_bin = last_bin;
-      for (std::uint32_t k = 0; k < k_count; ++k) (k < best.bin ? best.left : best.right).grow(bin_box[a][k]);
+      best.map = map;
+      for (std::uint32_t k = 0; k < k_count; ++k) (k < best.bin ? best.left : best.right).grow(bins.box[a][k]);
     }
     return best;
+  }
+
+  // Adds refs_[begin, end) to bins. Long ranges alternate between two sets
+  // of bins: consecutive references often fall into the same bin, and with
+  // one set each update would wait for the store of the one before.
+  void bin_range(std::uint32_t begin, std::uint32_t end, const BinMap& map, Bins& bins) const {
+    std::uint32_t i = begin;
+    if (end - begin >= kTwoSetMin) {
+      std::unique_ptr<Bins> odd = std::make_unique<Bins>();
+      odd->clear(map.count);
+      for (; i + 1 < end; i += 2) {
+        bins.add(bins_of(refs_[i].centre(), map.offset, map.scale, map.last_bin), refs_[i].box);
+        odd->add(bins_of(refs_[i + 1].centre(), map.offset, map.scale, map.last_bin), refs_[i + 1].box);
+      }
+      bins.merge(*odd, map.count);
+    }
+    for (; i < end; ++i) bins.add(bins_of(refs_[i].centre(), map.offset, map.scale, map.last_bin), refs_[i].box);
   }
 
   // Partitions the range by the split's plane; fills both sides' centre
@@ -196,7 +257,7 @@ class SahBuilder {
   std::uint32_t partition(const Range& range, const Split& split, Range& left, Range& right) {
     const int a = split.axis;
     auto goes_left = [&](Float4 c) {
-      return bins_of(c, split.offset, split.scale, split.last_bin)[a] < static_cast<int>(split.bin);
+      return bins_of(c, split.map.offset, split.map.scale, split.map.last_bin)[a] < static_cast<int>(split.bin);
     };
     std::uint32_t i = range.begin, j = range.end;
     for (;;) {
@@ -265,29 +326,64 @@ class SahBuilder {
     inner.bounds = range.bounds.aabb();
     inner.child[0] = first_child;
     inner.child[1] = first_child + 1;
-    if (n >= config_.parallel_min_primitives && try_take_thread()) {
-      std::thread worker([&] { build(first_child, left, depth + 1); });
-      build(first_child + 1, right, depth + 1);
-      worker.join();
-      spare_threads_.fetch_add(1);
+    const bool left_smaller = left.end - left.begin < right.end - right.begin;
+    const Range& small = left_smaller ? left : right;
+    const Range& large = left_smaller ? right : left;
+    const std::uint32_t small_node = first_child + (left_smaller ? 0 : 1);
+    const std::uint32_t large_node = first_child + (left_smaller ? 1 : 0);
+    if (small.end - small.begin >= config_.parallel_min_primitives && idle_threads_.load(std::memory_order_relaxed) > 0) {
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        tasks_.push_back({small_node, small, depth + 1});
+      }
+      ready_.notify_one();
     } else {
-      build(first_child, left, depth + 1);
-      build(first_child + 1, right, depth + 1);
+      build(small_node, small, depth + 1);
+    }
+    build(large_node, large, depth + 1);
+  }
+
+  // One thread of the build: takes subtrees from tasks_ (the largest first)
+  // until none is left and no thread is building one (which could add more).
+  void work() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      idle_threads_.fetch_add(1);
+      ready_.wait(lock, [&] { return !tasks_.empty() || busy_threads_ == 0; });
+      idle_threads_.fetch_sub(1);
+      if (tasks_.empty()) {
+        ready_.notify_all();
+        return;
+      }
+      auto largest = std::max_element(tasks_.begin(), tasks_.end(), [](const Task& a, const Task& b) {
+        return a.range.end - a.range.begin < b.range.end - b.range.begin;
+      });
+      Task task = *largest;
+      tasks_.erase(largest);
+      ++busy_threads_;
+      lock.unlock();
+      build(task.node, task.range, task.depth);
+      lock.lock();
+      --busy_threads_;
     }
   }
 
-  bool try_take_thread() {
-    int spare = spare_threads_.load();
-    while (spare > 0)
-      if (spare_threads_.compare_exchange_weak(spare, spare - 1)) return true;
-    return false;
-  }
+  struct Task {
+    std::uint32_t node;
+    Range range;
+    std::uint32_t depth;
+  };
 
   const SahConfig& config_;
   std::vector<PrimRef> refs_;
   std::vector<BuildNode> nodes_;  // at most 2n - 1 for n primitives
   std::atomic<std::uint32_t> node_count_{1};
-  std::atomic<int> spare_threads_{0};
+  unsigned thread_count_ = 1;
+  std::mutex mutex_;
+  std::condition_variable ready_;
+  std::vector<Task> tasks_;     // subtrees waiting for a thread
+  int busy_threads_ = 0;        // threads building a task (guarded by mutex_)
+  std::atomic<int> idle_threads_{0};  // threads waiting for a task
 };
 
 }  // namespace
