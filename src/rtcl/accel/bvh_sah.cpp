@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <thread>
 #include <vector>
 
@@ -135,21 +136,25 @@ struct Range {
 class SahBuilder {
  public:
   SahBuilder(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config)
-      : config_(config), refs_(bounds.size()), nodes_(2 * bounds.size()) {
+      : config_(config),
+        refs_(std::make_unique_for_overwrite<PrimRef[]>(bounds.size())),
+        ref_count_(bounds.size()),
+        node_storage_(std::make_unique_for_overwrite<std::byte[]>(2 * bounds.size() * sizeof(BuildNode))),
+        nodes_(reinterpret_cast<BuildNode*>(node_storage_.get())) {
     for (std::size_t i = 0; i < bounds.size(); ++i) {
       const Aabb& b = bounds[i];
       refs_[i].box = {Float4{b.lower.x, b.lower.y, b.lower.z, 0.0f},
                       Float4{b.upper.x, b.upper.y, b.upper.z, std::bit_cast<float>(ids[i])}};
     }
     thread_count_ = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
-    if (refs_.size() < 2 * config.parallel_min_primitives) thread_count_ = 1;
+    if (ref_count_ < 2 * config.parallel_min_primitives) thread_count_ = 1;
   }
 
   BuildTree run() {
     BuildTree tree;
-    if (refs_.empty()) return tree;
-    Range all{0, static_cast<std::uint32_t>(refs_.size()), Box::empty(), Box::empty()};
-    for (const PrimRef& r : refs_) {
+    if (ref_count_ == 0) return tree;
+    Range all{0, static_cast<std::uint32_t>(ref_count_), Box::empty(), Box::empty()};
+    for (const PrimRef& r : std::span(refs_.get(), ref_count_)) {
       all.bounds.grow(r.box);
       all.centres.grow_point(r.centre());
     }
@@ -158,10 +163,9 @@ class SahBuilder {
     for (unsigned t = 1; t < thread_count_; ++t) helpers.emplace_back([this] { work(); });
     work();
     for (std::thread& helper : helpers) helper.join();
-    nodes_.resize(node_count_.load());
-    tree.nodes = std::move(nodes_);
-    tree.prims.resize(refs_.size());
-    for (std::size_t i = 0; i < refs_.size(); ++i) tree.prims[i] = refs_[i].id();
+    tree.nodes.assign(nodes_, nodes_ + node_count_.load());
+    tree.prims.resize(ref_count_);
+    for (std::size_t i = 0; i < ref_count_; ++i) tree.prims[i] = refs_[i].id();
     return tree;
   }
 
@@ -283,7 +287,7 @@ class SahBuilder {
     for (int a = 1; a < 3; ++a)
       if (range.centres.hi[a] - range.centres.lo[a] > range.centres.hi[axis] - range.centres.lo[axis]) axis = a;
     std::uint32_t mid = range.begin + (range.end - range.begin) / 2;
-    std::nth_element(refs_.begin() + range.begin, refs_.begin() + mid, refs_.begin() + range.end,
+    std::nth_element(refs_.get() + range.begin, refs_.get() + mid, refs_.get() + range.end,
                      [axis](const PrimRef& x, const PrimRef& y) { return x.centre()[axis] < y.centre()[axis]; });
     return mid;
   }
@@ -295,7 +299,7 @@ class SahBuilder {
     if (n > 1 && depth < config_.max_sah_depth) split = find_split(range);
     if (n <= config_.max_leaf_size &&
         (split.axis < 0 || area * blocks(n) <= config_.node_cost * area + split.cost)) {
-      BuildNode& leaf = nodes_[node];
+      BuildNode& leaf = *new (nodes_ + node) BuildNode;
       leaf.bounds = range.bounds.aabb();
       leaf.first = range.begin;
       leaf.count = n;
@@ -322,7 +326,7 @@ class SahBuilder {
       }
     }
     std::uint32_t first_child = node_count_.fetch_add(2);
-    BuildNode& inner = nodes_[node];
+    BuildNode& inner = *new (nodes_ + node) BuildNode;
     inner.bounds = range.bounds.aabb();
     inner.child[0] = first_child;
     inner.child[1] = first_child + 1;
@@ -375,8 +379,13 @@ class SahBuilder {
   };
 
   const SahConfig& config_;
-  std::vector<PrimRef> refs_;
-  std::vector<BuildNode> nodes_;  // at most 2n - 1 for n primitives
+  std::unique_ptr<PrimRef[]> refs_;  // not initialised before the constructor fills it
+  std::size_t ref_count_;
+  // Room for the at most 2n - 1 nodes of n primitives, not initialised:
+  // only the pages of the nodes built (about 2n / 7 with full leaves) are
+  // touched.
+  std::unique_ptr<std::byte[]> node_storage_;
+  BuildNode* nodes_;
   std::atomic<std::uint32_t> node_count_{1};
   unsigned thread_count_ = 1;
   std::mutex mutex_;
