@@ -37,6 +37,10 @@
  * "Results"). */
 #define RTCL_INLINE_TRIANGLE_LANES
 #define RTCL_INLINE_TRIANGLE_BLOCK
+/* The ray setup inlined into the kernel (shared/ray.h): 1.05-1.2x the
+ * rays/s on the bench/ scenes (README, "Kernel levers on the single-ray
+ * BVH"). */
+#define RTCL_INLINE_RAY_SETUP
 #include "shared/bvh8_stack.h"
 #include "shared/trace.h"
 #if defined(RTCL_BVH_SPHERES) || defined(RTCL_BVH_KDOP) || defined(RTCL_BVH_OBB)

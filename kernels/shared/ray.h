@@ -63,9 +63,19 @@ inline int rtcl_ray_valid(float ox, float oy, float oz, float dx, float dy, floa
   return finite & nonzero & !rtcl_is_nan(tmin) & !rtcl_is_nan(tmax) & (tmin <= tmax);
 }
 
+/* How trace_ray_setup is compiled: a plain inline function, which PoCL
+ * keeps as a call (the Ray passed by value through memory), or always
+ * inlined where the kernel defines RTCL_INLINE_RAY_SETUP (the BVH,
+ * kernels/accel/bvh.cl: README, "Kernel levers on the single-ray BVH"). */
+#ifdef RTCL_INLINE_RAY_SETUP
+#define RTCL_RAY_SETUP_INLINE inline __attribute__((always_inline))
+#else
+#define RTCL_RAY_SETUP_INLINE inline
+#endif
+
 /* Returns 0 for a ray that cannot be traced (rtcl_ray_valid); such a ray
  * reports a miss. */
-inline int trace_ray_setup(const Ray r, TraceRay* s) {
+RTCL_RAY_SETUP_INLINE int trace_ray_setup(const Ray r, TraceRay* s) {
   if (!rtcl_ray_valid(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, r.tmin, r.tmax)) return 0;
   float o[3] = {r.ox, r.oy, r.oz};
   float d[3] = {r.dx, r.dy, r.dz};
