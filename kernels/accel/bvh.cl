@@ -138,7 +138,7 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
     do {
       if (sp == 0) return;
       --sp;
-    } while (stack_t[sp] > h->t_best);
+    } while (!RTCL_ANY_HIT && stack_t[sp] > h->t_best);
     ref = stack_ref[sp];
   }
 }
