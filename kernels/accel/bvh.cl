@@ -37,6 +37,10 @@
  * "Results"). */
 #define RTCL_INLINE_TRIANGLE_LANES
 #define RTCL_INLINE_TRIANGLE_BLOCK
+/* The ray setup inlined into the kernel (shared/ray.h): 1.05-1.2x the
+ * rays/s on the bench/ scenes (README, "Kernel levers on the single-ray
+ * BVH"). */
+#define RTCL_INLINE_RAY_SETUP
 #include "shared/bvh8_stack.h"
 #include "shared/trace.h"
 #if defined(RTCL_BVH_SPHERES) || defined(RTCL_BVH_KDOP) || defined(RTCL_BVH_OBB)
@@ -134,7 +138,7 @@ __attribute__((noinline)) void bvh_traverse(const TraceRay* s, HitState* h, glob
     do {
       if (sp == 0) return;
       --sp;
-    } while (stack_t[sp] > h->t_best);
+    } while (!RTCL_ANY_HIT && stack_t[sp] > h->t_best);
     ref = stack_ref[sp];
   }
 }

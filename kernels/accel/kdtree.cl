@@ -144,7 +144,7 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
     do {
       if (sp == 0) return;
       --sp;
-    } while (stack_t[sp] > h->t_best);
+    } while (!RTCL_ANY_HIT && stack_t[sp] > h->t_best);
     ref = stack_ref[sp];
   }
 }
