@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <random>
@@ -418,6 +419,78 @@ TEST(Bvh, FlattenRejectsTreesThatDoNotMatchTheGeometry) {
     if (n.is_leaf()) n.first = 0;
   EXPECT_THROW(flatten_bvh8(twice, g), Error);
   EXPECT_THROW(flatten_bvh8(BuildTree{}, g), Error);
+}
+
+// Soup and spheres enough for the gather to split the blocks over threads
+// (at 512 blocks and more).
+Geometry soup_with_spheres(std::uint32_t seed) {
+  Geometry g = random_soup(20000, seed);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int i = 0; i < 5000; ++i) g.spheres.push_back({{unit(rng), unit(rng), unit(rng)}, 0.01f});
+  return g;
+}
+
+template <class T>
+bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+TEST(Bvh, FlattenDoesNotDependOnTheThreads) {
+  Geometry g = soup_with_spheres(52);
+  BuildTree tree = build_binary_bvh(g);
+  Bvh8 one = flatten_bvh8(tree, g, true, 1);
+  for (unsigned threads : {2u, 3u}) {
+    Bvh8 many = flatten_bvh8(tree, g, true, threads);
+    EXPECT_TRUE(same_bytes(one.nodes, many.nodes)) << threads << " threads";
+    EXPECT_TRUE(same_bytes(one.blocks.triangles, many.blocks.triangles)) << threads << " threads";
+    EXPECT_TRUE(same_bytes(one.blocks.spheres, many.blocks.spheres)) << threads << " threads";
+    EXPECT_EQ(one.stack_size, many.stack_size);
+    EXPECT_EQ(one.depth, many.depth);
+  }
+}
+
+std::string flatten_error(const BuildTree& tree, const Geometry& g, unsigned threads) {
+  try {
+    flatten_bvh8(tree, g, true, threads);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A mismatch met only by the second gather thread is found as well: a
+// primitive in the first and the last block (each thread marks it once),
+// and a last leaf that does not contain its primitive.
+TEST(Bvh, FlattenRejectsMismatchesOnEveryThread) {
+  Geometry g = soup_with_spheres(53);
+  BuildTree tree = build_binary_bvh(g);
+  // The primitive in lane 0 of the first and of the last triangle block, and
+  // where the tree holds the latter; the walk (hence the blocks) does not
+  // depend on which ids the leaves hold.
+  auto ends = [&](const BuildTree& t) {
+    Bvh8 bvh = flatten_bvh8(t, g, true, 2);
+    auto first = static_cast<std::uint32_t>(bvh.blocks.triangles.front().prim[0]);
+    auto last = static_cast<std::uint32_t>(bvh.blocks.triangles.back().prim[0]);
+    auto at = static_cast<std::size_t>(std::find(t.prims.begin(), t.prims.end(), last) - t.prims.begin());
+    return std::pair(first, at);
+  };
+
+  // Every box the scene's, so that no box check objects to the moved id.
+  BuildTree twice = tree;
+  for (BuildNode& n : twice.nodes) n.bounds = g.bounds();
+  auto [first, at] = ends(twice);
+  twice.prims[at] = first;
+  std::string error = flatten_error(twice, g, 2);
+  EXPECT_NE(error.find("primitive " + std::to_string(first) + " is in two leaves"), std::string::npos) << error;
+
+  BuildTree outside = tree;
+  at = ends(tree).second;
+  for (BuildNode& n : outside.nodes)
+    if (n.is_leaf() && n.first <= at && at < n.first + n.count) n.bounds.upper = n.bounds.lower;
+  error = flatten_error(outside, g, 2);
+  EXPECT_NE(error.find("does not contain primitive " + std::to_string(outside.prims[at])), std::string::npos)
+      << error;
 }
 
 // A chain of binary nodes (what a builder without a depth bound makes of

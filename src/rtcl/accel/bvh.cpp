@@ -1,11 +1,9 @@
 #include "rtcl/accel/bvh.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cfloat>
 #include <chrono>
 #include <cmath>
-#include <limits>
 
 #include "rtcl/error.hpp"
 
@@ -24,211 +22,6 @@ Aabb sphere_bounds(const Sphere& s) {
 BuildTree build_kind(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const BvhConfig& config) {
   return config.builder == BvhBuilder::ploc ? build_ploc(bounds, ids, config.ploc) : build_sah(bounds, ids, config.sah);
 }
-
-bool contains(const Aabb& outer, const Aabb& inner) {
-  return glm::all(glm::lessThanEqual(outer.lower, inner.lower)) &&
-         glm::all(glm::greaterThanEqual(outer.upper, inner.upper));
-}
-
-// One child of a wide node while it is formed: an inner binary node, or a
-// group of binary leaves that will share one block.
-struct Slot {
-  Aabb bounds;
-  std::uint32_t node = 0;  // inner binary node (when !leaf)
-  bool leaf = false;
-  bool spheres = false;
-  std::uint32_t count = 0;  // primitives (leaf groups)
-  std::array<std::uint32_t, RTCL_BLOCK_WIDTH> leaves{};  // binary leaves in the group
-  std::uint32_t leaf_count = 0;
-};
-
-class Flattener {
- public:
-  Flattener(const BuildTree& tree, const Geometry& geometry, bool merge_leaves)
-      : tree_(tree), geometry_(geometry), merge_leaves_(merge_leaves), node_seen_(tree.nodes.size(), 0),
-        prim_seen_(geometry.primitive_count(), 0) {}
-
-  Bvh8 run() {
-    if (tree_.empty()) fail("the build tree is empty");
-    struct Todo {
-      std::uint32_t binary, wide, stack, depth;  // stack: entries its ancestors leave on the stack, worst case
-    };
-    out_.nodes.emplace_back();
-    std::vector<Todo> todo{{0, 0, 0, 1}};
-    visit(0);
-    while (!todo.empty()) {
-      Todo t = todo.back();
-      todo.pop_back();
-      std::vector<Slot> slots = form_slots(t.binary);
-      // The kernel pushes the children it enters and pops the one it visits
-      // next (kernels/accel/bvh.cl): entries peak at t.stack + children.
-      auto children = static_cast<std::uint32_t>(slots.size());
-      out_.stack_size = std::max(out_.stack_size, t.stack + children);
-      std::uint32_t below = t.stack + children - 1;  // left for each child's subtree
-      out_.depth = std::max(out_.depth, t.depth);
-      if (out_.stack_size > kBvhMaxStackSize)
-        throw Error("BVH over " + geometry_.source + ": the tree needs a traversal stack of more than " +
-                    std::to_string(kBvhMaxStackSize) + " entries (depth " + std::to_string(t.depth) +
-                    "); lower SahConfig::max_sah_depth or PlocConfig::max_depth");
-      Bvh8Node node;
-      for (int row = 0; row < 6; ++row)
-        for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
-          node.bounds[row][lane] = row < 3 ? std::numeric_limits<float>::infinity()
-                                           : -std::numeric_limits<float>::infinity();
-      for (int& c : node.child) c = RTCL_CHILD_EMPTY;
-      std::size_t first_todo = todo.size();
-      for (std::size_t lane = 0; lane < slots.size(); ++lane) {
-        const Slot& s = slots[lane];
-        for (int a = 0; a < 3; ++a) {
-          node.bounds[a][lane] = s.bounds.lower[a];
-          node.bounds[3 + a][lane] = s.bounds.upper[a];
-        }
-        if (s.leaf) {
-          node.child[lane] = emit_block(s);
-        } else {
-          auto index = static_cast<std::uint32_t>(out_.nodes.size());
-          if (index > 0x7ffffffeu) fail("too many nodes");
-          out_.nodes.emplace_back();
-          node.child[lane] = static_cast<rtcl_i32>(index);
-          todo.push_back({s.node, index, below, t.depth + 1});
-        }
-      }
-      std::reverse(todo.begin() + static_cast<std::ptrdiff_t>(first_todo), todo.end());
-      out_.nodes[t.wide] = node;
-    }
-    for (std::size_t p = 0; p < prim_seen_.size(); ++p) {
-      bool stored = p >= geometry_.triangles.size() || !zero_area(geometry_, p);
-      if (stored && !prim_seen_[p]) fail("primitive " + std::to_string(p) + " is in no leaf");
-      if (!stored && prim_seen_[p]) fail("zero-area triangle " + std::to_string(p) + " is in a leaf");
-    }
-    return std::move(out_);
-  }
-
- private:
-  [[noreturn]] void fail(const std::string& what) const {
-    throw Error("internal: BVH over " + geometry_.source + ": " + what);
-  }
-
-  void visit(std::uint32_t n) {
-    if (n >= tree_.nodes.size()) fail("child " + std::to_string(n) + " does not exist");
-    if (node_seen_[n]++) fail("node " + std::to_string(n) + " is reached twice");
-  }
-
-  Slot slot_of(std::uint32_t n) {
-    const BuildNode& b = tree_.nodes[n];
-    Slot s;
-    s.bounds = b.bounds;
-    s.node = n;
-    if (!b.is_leaf()) return s;
-    if (b.count > RTCL_BLOCK_WIDTH || std::size_t(b.first) + b.count > tree_.prims.size())
-      fail("leaf " + std::to_string(n) + " has " + std::to_string(b.count) + " primitives from " +
-           std::to_string(b.first));
-    s.leaf = true;
-    s.count = b.count;
-    s.leaves[0] = n;
-    s.leaf_count = 1;
-    s.spheres = tree_.prims[b.first] >= geometry_.triangles.size();
-    for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
-      std::uint32_t p = tree_.prims[k];
-      if (p >= geometry_.primitive_count()) fail("leaf " + std::to_string(n) + " holds unknown id " + std::to_string(p));
-      if ((p >= geometry_.triangles.size()) != s.spheres) fail("leaf " + std::to_string(n) + " mixes kinds");
-      if (!contains(b.bounds, geometry_.primitive_bounds(p)))
-        fail("leaf " + std::to_string(n) + " does not contain primitive " + std::to_string(p));
-    }
-    return s;
-  }
-
-  // The children of the wide node made from binary node n.
-  std::vector<Slot> form_slots(std::uint32_t n) {
-    std::vector<Slot> slots;
-    if (tree_.nodes[n].is_leaf()) {
-      slots.push_back(slot_of(n));
-      return slots;
-    }
-    open(n, slots);
-    for (;;) {
-      while (slots.size() < RTCL_BLOCK_WIDTH) {
-        int widest = -1;
-        for (std::size_t i = 0; i < slots.size(); ++i)
-          if (!slots[i].leaf && (widest < 0 || slots[i].bounds.area() > slots[widest].bounds.area()))
-            widest = static_cast<int>(i);
-        if (widest < 0) break;
-        std::uint32_t inner = slots[widest].node;
-        slots.erase(slots.begin() + widest);
-        open(inner, slots);
-      }
-      bool merged = merge_leaves_ && merge_one_pair(slots);
-      bool can_open = std::any_of(slots.begin(), slots.end(), [](const Slot& s) { return !s.leaf; });
-      if (!merged || !can_open) {
-        while (merge_leaves_ && merge_one_pair(slots)) {
-        }
-        break;
-      }
-    }
-    return slots;
-  }
-
-  // Appends the two children of inner binary node n, checked: each exists,
-  // is reached once and lies inside n's box.
-  void open(std::uint32_t n, std::vector<Slot>& slots) {
-    const BuildNode& b = tree_.nodes[n];
-    for (std::uint32_t c : b.child) {
-      visit(c);
-      if (!contains(b.bounds, tree_.nodes[c].bounds))
-        fail("node " + std::to_string(n) + " does not contain its child " + std::to_string(c));
-      slots.push_back(slot_of(c));
-    }
-  }
-
-  // Merges the pair of leaf groups whose union saves the most area (SAH:
-  // one block test on the union instead of one on each); false when none
-  // fits in a block without raising the cost.
-  static bool merge_one_pair(std::vector<Slot>& slots) {
-    int best_i = -1, best_j = -1;
-    float best_saving = -1.0f;
-    for (std::size_t i = 0; i < slots.size(); ++i) {
-      if (!slots[i].leaf) continue;
-      for (std::size_t j = i + 1; j < slots.size(); ++j) {
-        const Slot &a = slots[i], &b = slots[j];
-        if (!b.leaf || a.spheres != b.spheres || a.count + b.count > RTCL_BLOCK_WIDTH) continue;
-        float saving = a.bounds.area() + b.bounds.area() - merge(a.bounds, b.bounds).area();
-        if (saving >= 0.0f && saving > best_saving) {
-          best_saving = saving;
-          best_i = static_cast<int>(i);
-          best_j = static_cast<int>(j);
-        }
-      }
-    }
-    if (best_i < 0) return false;
-    Slot& a = slots[best_i];
-    const Slot& b = slots[best_j];
-    a.bounds = merge(a.bounds, b.bounds);
-    a.count += b.count;
-    for (std::uint32_t k = 0; k < b.leaf_count; ++k) a.leaves[a.leaf_count++] = b.leaves[k];
-    slots.erase(slots.begin() + best_j);
-    return true;
-  }
-
-  rtcl_i32 emit_block(const Slot& s) {
-    std::array<std::uint32_t, RTCL_BLOCK_WIDTH> prims{};
-    std::uint32_t n = 0;
-    for (std::uint32_t k = 0; k < s.leaf_count; ++k) {
-      const BuildNode& b = tree_.nodes[s.leaves[k]];
-      for (std::uint32_t i = b.first; i < b.first + b.count; ++i) {
-        std::uint32_t p = tree_.prims[i];
-        if (prim_seen_[p]++) fail("primitive " + std::to_string(p) + " is in two leaves");
-        prims[n++] = p;
-      }
-    }
-    return out_.blocks.append(geometry_, std::span(prims.data(), n));
-  }
-
-  const BuildTree& tree_;
-  const Geometry& geometry_;
-  bool merge_leaves_;
-  std::vector<char> node_seen_, prim_seen_;
-  Bvh8 out_;
-};
 
 class BvhAccel final : public Accel {
   static inline const TraceKernels kPacket{"accel/bvh_packet.cl", RTCL_BLOCK_WIDTH};
@@ -271,8 +64,8 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config) {
               build_kind(all_bounds.subspan(first_sphere), all_ids.subspan(first_sphere), config));
 }
 
-Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves) {
-  return Flattener(tree, geometry, merge_leaves).run();
+unsigned bvh_thread_count(const BvhConfig& config) {
+  return config.builder == BvhBuilder::ploc ? config.ploc.thread_count : config.sah.thread_count;
 }
 
 std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size) { return std::max(8u, (stack_size + 7u) / 8u * 8u); }
@@ -299,7 +92,8 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
                                 std::string name, const AccelConfig& accel_config) {
   auto start = std::chrono::steady_clock::now();
   GeometryReport report = validate(geometry);
-  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, config), geometry, config.merge_leaves);
+  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, config), geometry, config.merge_leaves,
+                         bvh_thread_count(config));
   AccelStats stats = bvh_stats(geometry, report, bvh, start);
   std::vector<std::string> defines = bvh_defines(geometry, bvh);
   return std::make_unique<BvhAccel>(device, std::move(name), config.traversal, std::move(defines), bvh, stats,

@@ -71,8 +71,13 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config = {
 // sibling leaves when `merge_leaves`). Checked: throws Error when the tree
 // does not hold every stored primitive of `geometry` exactly once in leaves
 // of 1..8 primitives of one kind, or its stack need exceeds
-// kBvhMaxStackSize.
-Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves = true);
+// kBvhMaxStackSize. The blocks are filled on up to `thread_count` threads (0 =
+// all hardware threads); the result does not depend on the threads.
+Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves = true,
+                  unsigned thread_count = 0);
+
+// The threads the config's builder may use (its thread_count).
+unsigned bvh_thread_count(const BvhConfig& config);
 
 // The largest traversal stack the kernel is compiled for (entries of 8 bytes
 // per work-item); a deeper tree is refused with an Error.

@@ -8,40 +8,42 @@
 
 namespace rtcl {
 
+TriangleBlock empty_triangle_block() {
+  TriangleBlock b;
+  for (auto& vertex : b.v)
+    for (auto& axis : vertex)
+      for (float& lane : axis) lane = std::numeric_limits<float>::quiet_NaN();
+  for (int& p : b.prim) p = -1;
+  return b;
+}
+
+SphereBlock empty_sphere_block() {
+  SphereBlock b;
+  for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+    b.cx[lane] = b.cy[lane] = b.cz[lane] = 0.0f;
+    b.r[lane] = std::numeric_limits<float>::quiet_NaN();
+    b.prim[lane] = -1;
+  }
+  return b;
+}
+
 rtcl_i32 PrimitiveBlocks::append(const Geometry& g, std::span<const std::uint32_t> prims) {
   if (prims.empty() || prims.size() > RTCL_BLOCK_WIDTH) throw Error("internal: leaf of " + std::to_string(prims.size()) + " primitives");
-  const float nan = std::numeric_limits<float>::quiet_NaN();
   bool spheres_leaf = prims[0] >= g.triangles.size();
   if (!spheres_leaf) {
-    TriangleBlock b;
-    for (auto& vertex : b.v)
-      for (auto& axis : vertex)
-        for (float& lane : axis) lane = nan;
-    for (int& p : b.prim) p = -1;
+    TriangleBlock b = empty_triangle_block();
     for (std::size_t lane = 0; lane < prims.size(); ++lane) {
       if (prims[lane] >= g.triangles.size()) throw Error("internal: mixed leaf");
       const glm::uvec3& t = g.triangles[prims[lane]];
-      for (int vertex = 0; vertex < 3; ++vertex)
-        for (int axis = 0; axis < 3; ++axis) b.v[vertex][axis][lane] = g.vertices[t[vertex]][axis];
-      b.prim[lane] = static_cast<rtcl_i32>(prims[lane]);
+      set_lane(b, lane, prims[lane], g.vertices[t.x], g.vertices[t.y], g.vertices[t.z]);
     }
     triangles.push_back(b);
     return RTCL_LEAF_TRIANGLES(triangles.size() - 1);
   }
-  SphereBlock b;
-  for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
-    b.cx[lane] = b.cy[lane] = b.cz[lane] = 0.0f;
-    b.r[lane] = nan;
-    b.prim[lane] = -1;
-  }
+  SphereBlock b = empty_sphere_block();
   for (std::size_t lane = 0; lane < prims.size(); ++lane) {
     if (prims[lane] < g.triangles.size()) throw Error("internal: mixed leaf");
-    const Sphere& s = g.spheres[prims[lane] - g.triangles.size()];
-    b.cx[lane] = s.center.x;
-    b.cy[lane] = s.center.y;
-    b.cz[lane] = s.center.z;
-    b.r[lane] = s.radius;
-    b.prim[lane] = static_cast<rtcl_i32>(prims[lane]);
+    set_lane(b, lane, prims[lane], g.spheres[prims[lane] - g.triangles.size()]);
   }
   spheres.push_back(b);
   return RTCL_LEAF_SPHERES(spheres.size() - 1);

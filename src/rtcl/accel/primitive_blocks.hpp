@@ -12,6 +12,30 @@
 
 namespace rtcl {
 
+// A block whose lanes are all unused: NaN vertices (triangles) or NaN radius
+// and zero centre (spheres), prim = -1.
+TriangleBlock empty_triangle_block();
+SphereBlock empty_sphere_block();
+
+// Stores primitive `prim` in `lane` of a block: a triangle's corners a, b, c
+// or a sphere.
+inline void set_lane(TriangleBlock& block, std::size_t lane, std::uint32_t prim, const glm::vec3& a,
+                     const glm::vec3& b, const glm::vec3& c) {
+  for (int axis = 0; axis < 3; ++axis) {
+    block.v[0][axis][lane] = a[axis];
+    block.v[1][axis][lane] = b[axis];
+    block.v[2][axis][lane] = c[axis];
+  }
+  block.prim[lane] = static_cast<rtcl_i32>(prim);
+}
+inline void set_lane(SphereBlock& block, std::size_t lane, std::uint32_t prim, const Sphere& s) {
+  block.cx[lane] = s.center.x;
+  block.cy[lane] = s.center.y;
+  block.cz[lane] = s.center.z;
+  block.r[lane] = s.radius;
+  block.prim[lane] = static_cast<rtcl_i32>(prim);
+}
+
 struct PrimitiveBlocks {
   std::vector<TriangleBlock> triangles;
   std::vector<SphereBlock> spheres;

@@ -43,8 +43,12 @@ Aabb Geometry::bounds() const {
 
 bool zero_area(const Geometry& g, std::size_t triangle) {
   const glm::uvec3& t = g.triangles[triangle];
-  glm::dvec3 a(g.vertices[t.x]), b(g.vertices[t.y]), c(g.vertices[t.z]);
-  glm::dvec3 n = glm::cross(b - a, c - a);
+  return zero_area(g.vertices[t.x], g.vertices[t.y], g.vertices[t.z]);
+}
+
+bool zero_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+  glm::dvec3 da(a), db(b), dc(c);
+  glm::dvec3 n = glm::cross(db - da, dc - da);
   return n.x == 0.0 && n.y == 0.0 && n.z == 0.0;
 }
 

@@ -47,5 +47,7 @@ GeometryReport validate(const Geometry& geometry);
 
 // True when the triangle's area is exactly zero in double precision.
 bool zero_area(const Geometry& geometry, std::size_t triangle);
+// The same test on the corners a, b, c.
+bool zero_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c);
 
 }  // namespace rtcl

@@ -1,0 +1,434 @@
+// flatten_bvh8 (bvh.hpp): the binary build tree collapsed into 8-wide nodes
+// and primitive blocks, in three passes.
+//
+// 1. Walk (one thread): wide nodes are formed depth first. A wide node's
+//    inner children get consecutive indices when it is formed, and the first
+//    child's subtree is formed before the second's; blocks are numbered in
+//    the order their wide nodes are formed. A block is recorded as its lanes'
+//    primitive ids and binary leaves; the walk reads the tree, never the
+//    geometry.
+// 2. Gather (block ranges on parallel threads): each block is filled from the
+//    geometry, every primitive's vertices read once and checked there: inside
+//    its binary leaf's box, not a zero-area triangle, not marked before by
+//    the same thread.
+// 3. Marks: no primitive marked by two threads, and every stored primitive
+//    marked.
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <exception>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rtcl/accel/bvh.hpp"
+#include "rtcl/error.hpp"
+
+namespace rtcl {
+
+namespace {
+
+bool contains(const Aabb& outer, const Aabb& inner) {
+  return glm::all(glm::lessThanEqual(outer.lower, inner.lower)) &&
+         glm::all(glm::greaterThanEqual(outer.upper, inner.upper));
+}
+
+bool contains(const Aabb& box, const glm::vec3& p) {
+  return glm::all(glm::lessThanEqual(box.lower, p)) && glm::all(glm::lessThanEqual(p, box.upper));
+}
+
+// One child of a wide node while it is formed: an inner binary node, or a
+// group of binary leaves that will share one block.
+struct Slot {
+  Aabb bounds;
+  std::uint32_t node = 0;  // inner binary node (when !leaf)
+  bool leaf = false;
+  bool spheres = false;
+  std::uint32_t count = 0;  // primitives (leaf groups)
+  std::array<std::uint32_t, RTCL_BLOCK_WIDTH> leaves{};  // binary leaves in the group, in lane order
+  std::uint32_t leaf_count = 0;
+};
+
+// The children of one wide node while it is formed, in lane order. At most
+// RTCL_BLOCK_WIDTH: a slot is opened (replaced by two) only below that.
+class SlotList {
+ public:
+  std::size_t size() const { return size_; }
+  Slot& operator[](std::size_t i) { return items_[i]; }
+  const Slot& operator[](std::size_t i) const { return items_[i]; }
+  const Slot* begin() const { return items_.data(); }
+  const Slot* end() const { return items_.data() + size_; }
+
+  void push_back(const Slot& s) {
+    if (size_ == items_.size()) throw Error("internal: BVH flatten: more than 8 children in a wide node");
+    items_[size_++] = s;
+  }
+  void erase(std::size_t i) {
+    std::copy(items_.begin() + static_cast<std::ptrdiff_t>(i) + 1,
+              items_.begin() + static_cast<std::ptrdiff_t>(size_), items_.begin() + static_cast<std::ptrdiff_t>(i));
+    --size_;
+  }
+
+ private:
+  std::array<Slot, RTCL_BLOCK_WIDTH> items_{};
+  std::size_t size_ = 0;
+};
+
+// What fills one block: each lane's primitive and the binary leaf that held
+// it (whose box must contain it).
+struct BlockSource {
+  std::array<std::uint32_t, RTCL_BLOCK_WIDTH> prims;
+  std::array<std::uint32_t, RTCL_BLOCK_WIDTH> leaves;
+  std::uint32_t count;  // lanes in use
+};
+
+Bvh8Node empty_node() {
+  Bvh8Node node;
+  for (int row = 0; row < 6; ++row)
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
+      node.bounds[row][lane] = row < 3 ? std::numeric_limits<float>::infinity()
+                                       : -std::numeric_limits<float>::infinity();
+  for (int& c : node.child) c = RTCL_CHILD_EMPTY;
+  return node;
+}
+
+// Blocks below which the gather stays on one thread (a thread start costs
+// about as much as gathering a few hundred blocks).
+constexpr std::size_t kParallelMinBlocks = 512;
+// How many blocks ahead of the one being filled the gather prefetches the
+// triangles' index records and leaf boxes, and then their vertices: the
+// reads are scattered over the geometry (leaf order), so each would
+// otherwise wait for memory in turn (soup:1000000, 2 threads: 16 and 8
+// blocks ahead 96 ms, 8 and 4 101 ms, none 230 ms).
+constexpr std::size_t kIndexAhead = 16;
+constexpr std::size_t kVertexAhead = 8;
+
+// Starts loading the cache line at p (for writing when Write). The empty asm
+// statement keeps loops whose only effect is prefetching: GCC 12 deletes them
+// as side-effect free (-ffinite-loops, on from -O2 in C++11 and later).
+template <int Write = 0>
+inline void prefetch(const void* p) {
+  __builtin_prefetch(p, Write);
+  asm volatile("" ::"r"(p));
+}
+
+class Flattener {
+ public:
+  Flattener(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count)
+      : tree_(tree), geometry_(geometry), merge_leaves_(merge_leaves), node_seen_(tree.nodes.size(), 0) {
+    threads_ = thread_count ? thread_count : std::max(1u, std::thread::hardware_concurrency());
+  }
+
+  Bvh8 run() {
+    if (tree_.empty()) fail("the build tree is empty");
+    walk();
+    gather();
+    check_every_primitive_once();
+    return std::move(out_);
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const {
+    throw Error("internal: BVH over " + geometry_.source + ": " + what);
+  }
+
+  // Pass 1: forms every wide node; blocks are recorded as sources.
+  void walk() {
+    struct Todo {
+      std::uint32_t binary, wide, stack, depth;  // stack: entries its ancestors leave on the stack, worst case
+    };
+    // Each wide node but a lone leaf root consumes at least one inner binary
+    // node; a block takes at least one binary leaf.
+    out_.nodes.reserve(tree_.nodes.size() / 2 + 1);
+    triangle_sources_.reserve(tree_.nodes.size() / 2 + 1);
+    out_.nodes.emplace_back();
+    std::vector<Todo> todo{{0, 0, 0, 1}};
+    visit(0);
+    const Bvh8Node empty = empty_node();
+    while (!todo.empty()) {
+      Todo t = todo.back();
+      todo.pop_back();
+      SlotList slots = form_slots(t.binary);
+      // The kernel pushes the children it enters and pops the one it visits
+      // next (kernels/accel/bvh.cl): entries peak at t.stack + children.
+      auto children = static_cast<std::uint32_t>(slots.size());
+      out_.stack_size = std::max(out_.stack_size, t.stack + children);
+      std::uint32_t below = t.stack + children - 1;  // left for each child's subtree
+      out_.depth = std::max(out_.depth, t.depth);
+      if (out_.stack_size > kBvhMaxStackSize)
+        throw Error("BVH over " + geometry_.source + ": the tree needs a traversal stack of more than " +
+                    std::to_string(kBvhMaxStackSize) + " entries (depth " + std::to_string(t.depth) +
+                    "); lower SahConfig::max_sah_depth or PlocConfig::max_depth");
+      Bvh8Node node = empty;
+      std::size_t first_todo = todo.size();
+      for (std::size_t lane = 0; lane < slots.size(); ++lane) {
+        const Slot& s = slots[lane];
+        for (int a = 0; a < 3; ++a) {
+          node.bounds[a][lane] = s.bounds.lower[a];
+          node.bounds[3 + a][lane] = s.bounds.upper[a];
+        }
+        if (s.leaf) {
+          node.child[lane] = record_block(s);
+        } else {
+          auto index = static_cast<std::uint32_t>(out_.nodes.size());
+          if (index > 0x7ffffffeu) fail("too many nodes");
+          out_.nodes.emplace_back();
+          node.child[lane] = static_cast<rtcl_i32>(index);
+          todo.push_back({s.node, index, below, t.depth + 1});
+        }
+      }
+      std::reverse(todo.begin() + static_cast<std::ptrdiff_t>(first_todo), todo.end());
+      out_.nodes[t.wide] = node;
+    }
+  }
+
+  void visit(std::uint32_t n) {
+    if (n >= tree_.nodes.size()) fail("child " + std::to_string(n) + " does not exist");
+    if (node_seen_[n]++) fail("node " + std::to_string(n) + " is reached twice");
+  }
+
+  // Binary node n as a slot. A leaf is checked against the tree alone (1..8
+  // known ids of one kind); its primitives' boxes are checked by the gather.
+  Slot slot_of(std::uint32_t n) const {
+    const BuildNode& b = tree_.nodes[n];
+    Slot s;
+    s.bounds = b.bounds;
+    s.node = n;
+    if (!b.is_leaf()) return s;
+    if (b.count > RTCL_BLOCK_WIDTH || std::size_t(b.first) + b.count > tree_.prims.size())
+      fail("leaf " + std::to_string(n) + " has " + std::to_string(b.count) + " primitives from " +
+           std::to_string(b.first));
+    s.leaf = true;
+    s.count = b.count;
+    s.leaves[0] = n;
+    s.leaf_count = 1;
+    s.spheres = tree_.prims[b.first] >= geometry_.triangles.size();
+    for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
+      std::uint32_t p = tree_.prims[k];
+      if (p >= geometry_.primitive_count()) fail("leaf " + std::to_string(n) + " holds unknown id " + std::to_string(p));
+      if ((p >= geometry_.triangles.size()) != s.spheres) fail("leaf " + std::to_string(n) + " mixes kinds");
+    }
+    return s;
+  }
+
+  // The children of the wide node made from binary node n.
+  SlotList form_slots(std::uint32_t n) {
+    SlotList slots;
+    if (tree_.nodes[n].is_leaf()) {
+      slots.push_back(slot_of(n));
+      return slots;
+    }
+    open(n, slots);
+    for (;;) {
+      while (slots.size() < RTCL_BLOCK_WIDTH) {
+        int widest = -1;
+        for (std::size_t i = 0; i < slots.size(); ++i)
+          if (!slots[i].leaf && (widest < 0 || slots[i].bounds.area() > slots[widest].bounds.area()))
+            widest = static_cast<int>(i);
+        if (widest < 0) break;
+        std::uint32_t inner = slots[widest].node;
+        slots.erase(static_cast<std::size_t>(widest));
+        open(inner, slots);
+      }
+      bool merged = merge_leaves_ && merge_one_pair(slots);
+      bool can_open = std::any_of(slots.begin(), slots.end(), [](const Slot& s) { return !s.leaf; });
+      if (!merged || !can_open) {
+        while (merge_leaves_ && merge_one_pair(slots)) {
+        }
+        break;
+      }
+    }
+    return slots;
+  }
+
+  // Appends the two children of inner binary node n, checked: each exists,
+  // is reached once and lies inside n's box.
+  void open(std::uint32_t n, SlotList& slots) {
+    const BuildNode& b = tree_.nodes[n];
+    for (std::uint32_t c : b.child) {
+      visit(c);
+      if (!contains(b.bounds, tree_.nodes[c].bounds))
+        fail("node " + std::to_string(n) + " does not contain its child " + std::to_string(c));
+      slots.push_back(slot_of(c));
+    }
+  }
+
+  // Merges the pair of leaf groups whose union saves the most area (SAH:
+  // one block test on the union instead of one on each); false when none
+  // fits in a block without raising the cost.
+  static bool merge_one_pair(SlotList& slots) {
+    int best_i = -1, best_j = -1;
+    float best_saving = -1.0f;
+    for (std::size_t i = 0; i < slots.size(); ++i) {
+      if (!slots[i].leaf) continue;
+      for (std::size_t j = i + 1; j < slots.size(); ++j) {
+        const Slot &a = slots[i], &b = slots[j];
+        if (!b.leaf || a.spheres != b.spheres || a.count + b.count > RTCL_BLOCK_WIDTH) continue;
+        float saving = a.bounds.area() + b.bounds.area() - merge(a.bounds, b.bounds).area();
+        if (saving >= 0.0f && saving > best_saving) {
+          best_saving = saving;
+          best_i = static_cast<int>(i);
+          best_j = static_cast<int>(j);
+        }
+      }
+    }
+    if (best_i < 0) return false;
+    Slot& a = slots[static_cast<std::size_t>(best_i)];
+    const Slot& b = slots[static_cast<std::size_t>(best_j)];
+    a.bounds = merge(a.bounds, b.bounds);
+    a.count += b.count;
+    for (std::uint32_t k = 0; k < b.leaf_count; ++k) a.leaves[a.leaf_count++] = b.leaves[k];
+    slots.erase(static_cast<std::size_t>(best_j));
+    return true;
+  }
+
+  // The leaf reference of the next block of s's kind, filled by the gather.
+  rtcl_i32 record_block(const Slot& s) {
+    BlockSource source;
+    source.count = 0;
+    for (std::uint32_t k = 0; k < s.leaf_count; ++k) {
+      const BuildNode& leaf = tree_.nodes[s.leaves[k]];
+      for (std::uint32_t i = 0; i < leaf.count; ++i) {
+        source.prims[source.count] = tree_.prims[leaf.first + i];
+        source.leaves[source.count++] = s.leaves[k];
+      }
+    }
+    std::vector<BlockSource>& sources = s.spheres ? sphere_sources_ : triangle_sources_;
+    sources.push_back(source);
+    auto block = sources.size() - 1;
+    return s.spheres ? RTCL_LEAF_SPHERES(block) : RTCL_LEAF_TRIANGLES(block);
+  }
+
+  // Pass 2: fills every block, the blocks of each kind split evenly over
+  // the threads; the first thread's error (in block order) is the one thrown.
+  void gather() {
+    out_.blocks.triangles.resize(triangle_sources_.size());
+    out_.blocks.spheres.resize(sphere_sources_.size());
+    std::size_t blocks = triangle_sources_.size() + sphere_sources_.size();
+    unsigned parts = blocks < kParallelMinBlocks ? 1u : threads_;
+    seen_.assign(parts, std::vector<std::uint64_t>(geometry_.primitive_count() / 64 + 1, 0));
+    std::vector<std::exception_ptr> errors(parts);
+    auto part = [&](unsigned k) {
+      try {
+        gather_triangles(seen_[k], triangle_sources_.size() * k / parts, triangle_sources_.size() * (k + 1) / parts);
+        gather_spheres(seen_[k], sphere_sources_.size() * k / parts, sphere_sources_.size() * (k + 1) / parts);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    };
+    std::vector<std::thread> helpers;
+    for (unsigned k = 1; k < parts; ++k) helpers.emplace_back(part, k);
+    part(0);
+    for (std::thread& helper : helpers) helper.join();
+    for (const std::exception_ptr& e : errors)
+      if (e) std::rethrow_exception(e);
+  }
+
+  void gather_triangles(std::vector<std::uint64_t>& seen, std::size_t begin, std::size_t end) {
+    for (std::size_t b = begin; b < std::min(end, begin + kIndexAhead); ++b) prefetch_indices(b);
+    for (std::size_t b = begin; b < std::min(end, begin + kVertexAhead); ++b) prefetch_vertices(b);
+    for (std::size_t b = begin; b < end; ++b) {
+      if (b + kIndexAhead < end) prefetch_indices(b + kIndexAhead);
+      if (b + kVertexAhead < end) prefetch_vertices(b + kVertexAhead);
+      fill_triangle_block(seen, b);
+    }
+  }
+
+  // The block's triangle records and its leaves' boxes.
+  void prefetch_indices(std::size_t block) const {
+    const BlockSource& source = triangle_sources_[block];
+    for (std::uint32_t lane = 0; lane < source.count; ++lane) {
+      prefetch(&geometry_.triangles[source.prims[lane]]);
+      if (lane == 0 || source.leaves[lane] != source.leaves[lane - 1]) prefetch(&tree_.nodes[source.leaves[lane]]);
+    }
+  }
+
+  void prefetch_vertices(std::size_t block) const {
+    const BlockSource& source = triangle_sources_[block];
+    for (std::uint32_t lane = 0; lane < source.count; ++lane) {
+      const glm::uvec3& t = geometry_.triangles[source.prims[lane]];
+      for (int k = 0; k < 3; ++k) prefetch(&geometry_.vertices[t[k]]);
+    }
+  }
+
+  void fill_triangle_block(std::vector<std::uint64_t>& seen, std::size_t block) {
+    const BlockSource& source = triangle_sources_[block];
+    TriangleBlock out = empty_triangle_block();
+    for (std::uint32_t lane = 0; lane < source.count; ++lane) {
+      std::uint32_t p = source.prims[lane];
+      const glm::uvec3& t = geometry_.triangles[p];
+      const glm::vec3 &a = geometry_.vertices[t.x], &b = geometry_.vertices[t.y], &c = geometry_.vertices[t.z];
+      const Aabb& box = tree_.nodes[source.leaves[lane]].bounds;
+      if (!contains(box, a) || !contains(box, b) || !contains(box, c)) fail_outside(source.leaves[lane], p);
+      if (zero_area(a, b, c)) fail("zero-area triangle " + std::to_string(p) + " is in a leaf");
+      mark(seen, p);
+      set_lane(out, lane, p, a, b, c);
+    }
+    out_.blocks.triangles[block] = out;
+  }
+
+  void gather_spheres(std::vector<std::uint64_t>& seen, std::size_t begin, std::size_t end) {
+    for (std::size_t block = begin; block < end; ++block) {
+      const BlockSource& source = sphere_sources_[block];
+      SphereBlock out = empty_sphere_block();
+      for (std::uint32_t lane = 0; lane < source.count; ++lane) {
+        std::uint32_t p = source.prims[lane];
+        if (!contains(tree_.nodes[source.leaves[lane]].bounds, geometry_.primitive_bounds(p)))
+          fail_outside(source.leaves[lane], p);
+        mark(seen, p);
+        set_lane(out, lane, p, geometry_.spheres[p - geometry_.triangles.size()]);
+      }
+      out_.blocks.spheres[block] = out;
+    }
+  }
+
+  [[noreturn]] void fail_outside(std::uint32_t leaf, std::uint32_t p) const {
+    fail("leaf " + std::to_string(leaf) + " does not contain primitive " + std::to_string(p));
+  }
+
+  // Sets p's bit in one thread's marks.
+  void mark(std::vector<std::uint64_t>& seen, std::uint32_t p) const {
+    std::uint64_t bit = std::uint64_t(1) << (p % 64);
+    if (seen[p / 64] & bit) fail("primitive " + std::to_string(p) + " is in two leaves");
+    seen[p / 64] |= bit;
+  }
+
+  // Pass 3: no primitive marked by two threads, and the unmarked ones are
+  // exactly the zero-area triangles.
+  void check_every_primitive_once() {
+    std::vector<std::uint64_t>& all = seen_[0];
+    for (std::size_t k = 1; k < seen_.size(); ++k)
+      for (std::size_t w = 0; w < all.size(); ++w) {
+        if (std::uint64_t twice = all[w] & seen_[k][w])
+          fail("primitive " + std::to_string(64 * w + static_cast<std::size_t>(std::countr_zero(twice))) +
+               " is in two leaves");
+        all[w] |= seen_[k][w];
+      }
+    const std::size_t count = geometry_.primitive_count();
+    for (std::size_t w = 0; w < all.size(); ++w)
+      for (std::uint64_t missing = ~all[w]; missing; missing &= missing - 1) {
+        std::size_t p = 64 * w + static_cast<std::size_t>(std::countr_zero(missing));
+        if (p >= count) break;
+        if (p >= geometry_.triangles.size() || !zero_area(geometry_, p))
+          fail("primitive " + std::to_string(p) + " is in no leaf");
+      }
+  }
+
+  const BuildTree& tree_;
+  const Geometry& geometry_;
+  bool merge_leaves_;
+  unsigned threads_ = 1;
+  std::vector<char> node_seen_;
+  std::vector<BlockSource> triangle_sources_, sphere_sources_;  // per block of out_.blocks, same order
+  std::vector<std::vector<std::uint64_t>> seen_;                // per gather thread: bit p = primitive p marked
+  Bvh8 out_;
+};
+
+}  // namespace
+
+Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count) {
+  return Flattener(tree, geometry, merge_leaves, thread_count).run();
+}
+
+}  // namespace rtcl
