@@ -258,27 +258,32 @@ class SahBuilder {
 
   // Partitions the range by the split's plane; fills both sides' centre
   // bounds (the boxes come from the bins). Both sides are non-empty.
+  // Branch-free (Lomuto: each reference is swapped with the first of the
+  // right side, which then grows by one unless it went left): which side a
+  // reference goes to is unpredictable, and a branch on it mispredicted
+  // about every other time.
   std::uint32_t partition(const Range& range, const Split& split, Range& left, Range& right) {
     const int a = split.axis;
-    auto goes_left = [&](Float4 c) {
-      return bins_of(c, split.map.offset, split.map.scale, split.map.last_bin)[a] < static_cast<int>(split.bin);
-    };
-    std::uint32_t i = range.begin, j = range.end;
-    for (;;) {
-      for (; i < j; ++i) {
-        Float4 c = refs_[i].centre();
-        if (!goes_left(c)) break;
-        left.centres.grow_point(c);
-      }
-      for (; i < j; --j) {
-        Float4 c = refs_[j - 1].centre();
-        if (goes_left(c)) break;
-        right.centres.grow_point(c);
-      }
-      if (i >= j) break;
-      std::swap(refs_[i], refs_[j - 1]);
+    const float offset = split.map.offset[a], scale = split.map.scale[a];
+    const auto bin = static_cast<float>(split.bin);
+    const Float4 inf = {kInf, kInf, kInf, kInf};
+    std::uint32_t store = range.begin;
+    for (std::uint32_t i = range.begin; i < range.end; ++i) {
+      PrimRef r = refs_[i];
+      Float4 c = r.centre();
+      // bins_of(c)[a] < bin: the same arithmetic, before the clamps, which
+      // cannot move a value across bin >= 1
+      const bool goes_left = (c[a] - offset) * scale < bin;
+      refs_[i] = refs_[store];
+      refs_[store] = r;
+      store += goes_left;
+      const Int4 mask = Int4{0, 0, 0, 0} - static_cast<int>(goes_left);
+      left.centres.lo = min4(left.centres.lo, mask ? c : inf);
+      left.centres.hi = max4(left.centres.hi, mask ? c : -inf);
+      right.centres.lo = min4(right.centres.lo, mask ? inf : c);
+      right.centres.hi = max4(right.centres.hi, mask ? -inf : c);
     }
-    return i;
+    return store;
   }
 
   // Object median along the longest centroid axis: both halves non-empty.
