@@ -43,33 +43,12 @@
 #include "rtcl/scene/mesh_io.hpp"
 #include "rtcl/scene/procedural.hpp"
 
+#include "../ab_support.hpp"
+
 namespace {
 
 using namespace rtcl;
 using namespace rtcl::bench;
-
-double kernel_ms(const cl::Event& e) {
-  e.wait();
-  return static_cast<double>(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
-                             e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
-         1e-6;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-double fastest(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
-
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 struct Key {
   int origin_bits = 0, direction_bits = 0;
@@ -278,11 +257,4 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "rtcl_ray_sort_ab: %s\n", e.what());
-    return 1;
-  }
-}
+int main(int argc, char** argv) { return rtcl::bench::run_main("rtcl_ray_sort_ab", run, argc, argv); }

@@ -1,0 +1,54 @@
+// Helpers of the A/B programs in bench/ (kernel_ab, ray_sort, build_ab):
+// event times, order statistics of repeated runs, comma lists.
+#pragma once
+
+#include "rtcl/cl/opencl.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace rtcl::bench {
+
+// Waits for e, then returns its kernel time in ms (profiling start to end).
+inline double kernel_ms(const cl::Event& e) {
+  e.wait();
+  return static_cast<double>(e.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                             e.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+         1e-6;
+}
+
+// The median of a non-empty set of times (the mean of the middle two for an
+// even count).
+inline double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+inline double fastest(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+
+// The non-empty items of a comma-separated list.
+inline std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+// main() of an A/B program: run(argc, argv)'s status, or one line naming
+// the program and the error and status 1.
+inline int run_main(const char* program, int (*run)(int, char**), int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: %s\n", program, e.what());
+    return 1;
+  }
+}
+
+}  // namespace rtcl::bench
