@@ -12,14 +12,14 @@
 // does. Per ray set: one launch per version whose hits are compared with the
 // first version's, bit for bit (a line "DIFFERS" names the rays that are
 // not; for any-hit rays only hit or miss must agree, another occluder is
-// counted on a line "other occluders"); then ROUNDS rounds of one launch per version, the order rotated each
-// round, and one Embree rtcIntersect1 / rtcOccluded1 trace of the same rays
-// on all hardware threads when built with Embree (the bench/ framing:
-// traversal only). Prints per version the median and fastest kernel time
-// (OpenCL events), its ratio to the first version (> 1: faster) and to
-// Embree (rtcl rays/s over Embree's). Versions measured in one process and
-// alternating see the same machine: on shared, drifting machines their
-// ratios hold where separate runs' do not.
+// counted on a line "other occluders"); then ROUNDS rounds of one launch
+// per version, the order rotated each round, and one Embree rtcIntersect1 /
+// rtcOccluded1 trace of the same rays on all hardware threads when built
+// with Embree (the bench/ framing: traversal only). Prints per version the
+// median and fastest kernel time (OpenCL events), its ratio to the first
+// version (> 1: faster) and to Embree (rtcl rays/s over Embree's).
+// Versions measured in one process and alternating see the same machine: on
+// shared, drifting machines their ratios hold where separate runs' do not.
 //
 // Environment: AB_ACCEL (structure, default bvh), AB_NO_EMBREE (set: no
 // Embree), RTCL_BENCH_RES, RTCL_SCENES_DIR, RTCL_DEVICE.

@@ -37,9 +37,9 @@
  * "Results"). */
 #define RTCL_INLINE_TRIANGLE_LANES
 #define RTCL_INLINE_TRIANGLE_BLOCK
-/* The ray setup inlined into the kernel (shared/ray.h): 1.05-1.2x the
- * rays/s on the bench/ scenes (README, "Kernel levers on the single-ray
- * BVH"). */
+/* The ray setup inlined into the kernel (shared/ray.h): 0.97-1.14x the
+ * kernel time on the twelve bench/ sets, above 1.03x on eleven (README,
+ * "Kernel levers on the single-ray BVH"). */
 #define RTCL_INLINE_RAY_SETUP
 #include "shared/bvh8_stack.h"
 #include "shared/trace.h"

@@ -4,9 +4,9 @@
  * t_entry within [sp at the node, sp), so the nearest child pops first; an
  * any-hit query skips the sorting and leaves stack_t unwritten: its first
  * hit ends the traversal, so its pops test no entry distance (measured:
- * 0.99-1.13x the shadow rays' kernel time, README "Kernel levers on the
- * single-ray BVH"). `node` is the Bvh8Node whose child[k] is pushed for
- * lane k. OpenCL C only. */
+ * 0.92-1.13x the shadow rays' kernel time, medians of two runs, above
+ * 1.03x in 6 of 8, README "Kernel levers on the single-ray BVH"). `node`
+ * is the Bvh8Node whose child[k] is pushed for lane k. OpenCL C only. */
 #ifndef RTCL_SHARED_BVH8_STACK_H
 #define RTCL_SHARED_BVH8_STACK_H
 

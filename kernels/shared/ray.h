@@ -183,8 +183,8 @@ inline float rtcl_max8(float8 a) {
 /* Index of the first lane of a that equals m (m is one of a's values; 0
  * where none does). A bit per lane, OR-reduced, and the lowest set bit's
  * index: PoCL turned a loop over the stored lanes into a store and a branch
- * per lane (measured: 1.02-1.07x the BVH's closest-hit kernel time, README
- * "Kernel levers on the single-ray BVH"). */
+ * per lane (measured: 1.00-1.27x the BVH's kernel time, medians on the
+ * twelve bench/ sets, README "Kernel levers on the single-ray BVH"). */
 inline int rtcl_lane_of(float8 a, float m) {
   int8 bits = (a == (float8)(m)) & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
   int4 o4 = bits.lo | bits.hi;

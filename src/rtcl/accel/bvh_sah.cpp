@@ -192,7 +192,8 @@ class SahBuilder {
     Bins bins;
     bins.clear(map.count);
     if (n >= kParallelBinMin && idle_threads_.load(std::memory_order_relaxed) > 0) {
-      // a thread is waiting for work: it bins the second half
+      // a thread waits for work, so one more may run: it bins the second
+      // half while this one bins the first
       std::uint32_t mid = range.begin + n / 2;
       std::unique_ptr<Bins> second = std::make_unique<Bins>();
       second->clear(map.count);
