@@ -1,0 +1,112 @@
+// rtcl_build_ab: rtcl's BVH build against Embree's default build, both on
+// all host threads, alternating in one process, scene by scene.
+//
+//   rtcl_build_ab SCENES ROUNDS
+//   e.g. rtcl_build_ab bunny,dragon,soup:1000000 7
+//
+// A scene is a bench/ scene name (the shared meshes, scene_catalog.hpp) or
+// soup:N (random_triangle_soup(N)). rtcl's time is what `rtcl bench`
+// reports as build_ms (make_bvh): validate, the binary SAH build and the
+// flatten into 8-wide nodes and blocks; the upload is not in it. Embree's is
+// EmbreeScene::build_ms: geometry setup and rtcCommitScene at
+// RTC_BUILD_QUALITY_MEDIUM (its default). One warm-up round per scene, then
+// ROUNDS rounds, the order of the two swapped each round. Prints per scene
+// the fastest and median ms of each and their ratios (rtcl / Embree: < 1
+// means rtcl builds faster).
+//
+// Environment: RTCL_SCENES_DIR.
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "rtcl/accel/bvh.hpp"
+#include "rtcl/bench/embree_baseline.hpp"
+#include "rtcl/bench/scene_catalog.hpp"
+#include "rtcl/error.hpp"
+#include "rtcl/scene/geometry.hpp"
+#include "rtcl/scene/mesh_io.hpp"
+#include "rtcl/scene/procedural.hpp"
+
+#include "../ab_support.hpp"
+
+namespace {
+
+using namespace rtcl;
+using namespace rtcl::bench;
+
+Geometry load_scene(const std::string& name, const std::string& scenes_dir) {
+  if (name.rfind("soup:", 0) == 0) {
+    char* end = nullptr;
+    const unsigned long long count = std::strtoull(name.c_str() + 5, &end, 10);
+    if (count == 0 || *end != '\0') throw Error("scene '" + name + "': soup:N needs a positive triangle count");
+    return random_triangle_soup(static_cast<std::size_t>(count));
+  }
+  const SceneSpec* spec = find_scene_spec(name);
+  if (!spec) throw Error("scene '" + name + "': neither a bench/ scene nor soup:N");
+  Geometry geometry = load_mesh(scenes_dir + "/" + spec->file).geometry;
+  if (spec->stadium > 0.0f) add_stadium(geometry, spec->stadium);
+  return geometry;
+}
+
+// make_bvh's build_ms path without the upload.
+double rtcl_build_ms(const Geometry& geometry, const BvhConfig& config) {
+  auto start = std::chrono::steady_clock::now();
+  validate(geometry);
+  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, config), geometry, config.merge_leaves,
+                         bvh_thread_count(config));
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (bvh.nodes.empty()) throw Error("empty BVH");
+  return ms;
+}
+
+double embree_build_ms(const Geometry& geometry, unsigned threads) {
+  return EmbreeScene(geometry, EmbreeQuality::standard, threads).build_ms();
+}
+
+int run(int argc, char** argv) {
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: rtcl_build_ab SCENES ROUNDS  (e.g. bunny,soup:1000000 7)\n");
+    return 2;
+  }
+  const std::vector<std::string> scenes = split(argv[1]);
+  const int rounds = std::atoi(argv[2]);
+  if (rounds < 1) throw Error(std::string("ROUNDS must be a positive number, not '") + argv[2] + "'");
+  const char* dir_env = std::getenv("RTCL_SCENES_DIR");
+  const std::string scenes_dir = dir_env && *dir_env ? dir_env : RTCL_BUILD_AB_SCENES_DIR;
+  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  const BvhConfig config;  // the "bvh" structure's defaults: SAH on all hardware threads
+  for (const std::string& name : scenes)
+    if (name.rfind("soup:", 0) != 0 && !find_scene_spec(name))
+      throw Error("scene '" + name + "': neither a bench/ scene nor soup:N");
+
+  std::printf("%u threads, Embree %s\n", threads, embree_version(threads).c_str());
+  std::printf("| scene | triangles | rtcl ms (min / median) | Embree ms (min / median) | rtcl / Embree (min / median) |\n");
+  std::printf("|---|--:|--:|--:|--:|\n");
+  for (const std::string& name : scenes) {
+    const Geometry geometry = load_scene(name, scenes_dir);
+    rtcl_build_ms(geometry, config);
+    embree_build_ms(geometry, threads);
+    std::vector<double> ours, theirs;
+    for (int round = 0; round < rounds; ++round) {
+      if (round % 2 == 0) {
+        ours.push_back(rtcl_build_ms(geometry, config));
+        theirs.push_back(embree_build_ms(geometry, threads));
+      } else {
+        theirs.push_back(embree_build_ms(geometry, threads));
+        ours.push_back(rtcl_build_ms(geometry, config));
+      }
+    }
+    std::printf("| %s | %zu | %.1f / %.1f | %.1f / %.1f | %.2f / %.2f |\n", name.c_str(), geometry.triangles.size(),
+                fastest(ours), median(ours), fastest(theirs), median(theirs), fastest(ours) / fastest(theirs),
+                median(ours) / median(theirs));
+    std::fflush(stdout);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return run_main("rtcl_build_ab", run, argc, argv); }
