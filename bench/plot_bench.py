@@ -15,9 +15,11 @@
 
     /usr/bin/python3 bench/plot_bench.py bench-results/bench.json [more.json ...] -o docs/bench
 
-Several JSON files (several machines) merge: their cells are plotted side by
-side, each device named with its machine's CPU. Needs matplotlib (Debian:
-python3-matplotlib).
+Several JSON files (several machines, or runs at several `--precision`
+levels) merge: their cells are plotted side by side, each device named with
+its machine's CPU, a structure at another level than robust named with it,
+and ratios against Embree's robust mode (`--embree-robust`) marked so.
+Needs matplotlib (Debian: python3-matplotlib).
 """
 import argparse
 import json
@@ -46,11 +48,17 @@ def load(paths):
             cell = dict(cell)
             cell["device_label"] = d["name"] if d["type"] != "cpu" else f"{d['platform']} on {cpu}"
             cell["scene_primitives"] = prims.get(cell["scene"], 0)
+            # runs at other precision levels (--precision) plot as structures of their own
+            if cell.get("precision", "robust") != "robust":
+                cell["accel"] = f"{cell['accel']} ({cell['precision']})"
+            if (data.get("embree") or {}).get("flags") == "robust" and cell.get("embree"):
+                cell["accel"] = f"{cell['accel']} vs robust Embree"
             cells.append(cell)
         embree = data.get("embree") or {}
         for b in embree.get("baselines", []):
             if not b["packets"]:
-                cells.append({"device_label": f"host, {cpu}", "accel": f"Embree {embree['version']}",
+                robust = " (robust)" if embree.get("flags") == "robust" else ""
+                cells.append({"device_label": f"host, {cpu}", "accel": f"Embree {embree['version']}{robust}",
                               "scene": b["scene"], "rays": b["rays"], "build_ms": b["build_ms"],
                               "scene_primitives": prims.get(b["scene"], 0), "baseline": True})
     return cells

@@ -49,6 +49,7 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
     EXPECT_TRUE(cell["check"]["ok"].is_boolean());
     EXPECT_GT(cell["check"]["rays"].get<int>(), 0) << cell.dump();
     EXPECT_EQ(cell["query"], cell["rays"] == "shadow" ? "any" : "closest");
+    EXPECT_EQ(cell["precision"], "robust");
     ASSERT_TRUE(cell.contains("embree"));
 #ifdef RTCL_TESTS_EXPECT_EMBREE
     // packets against packets: the packet kernel is compared with rtcIntersect8 / rtcOccluded8
@@ -89,6 +90,33 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
   EXPECT_NE(md.find("| tetra:levels=2 | grid |"), std::string::npos) << md;
 }
 
+// --precision sets every structure's level and --embree-robust Embree's
+// watertight mode; both are recorded with the run and its cells.
+TEST(CliBench, PrecisionAndEmbreeFlagsAreRecorded) {
+  TempDir dir;
+  CliRun run = run_cli(dir,
+                       {"bench", "--size", "16", "--scene", "bunny", "--accel", "bvh", "--rays", "primary,shadow",
+                        "--repeat", "1", "--check-rays", "32", "--device", "0", "--precision", "fast",
+                        "--embree-robust", "-o", dir.file("out")},
+                       scenes_env());
+  ASSERT_EQ(run.status, 0) << run.err;
+  nlohmann::json json = nlohmann::json::parse(read_text(dir.file("out/bench.json")));
+  EXPECT_EQ(json["options"]["precision"], "fast");
+  EXPECT_EQ(json["options"]["embree_flags"], "robust");
+  ASSERT_EQ(json["cells"].size(), 2u);
+  for (const auto& cell : json["cells"]) {
+    EXPECT_EQ(cell["precision"], "fast");
+    EXPECT_TRUE(cell["check"]["ok"].get<bool>()) << cell.dump();
+  }
+#ifdef RTCL_TESTS_EXPECT_EMBREE
+  ASSERT_TRUE(json["embree"].is_object());
+  EXPECT_EQ(json["embree"]["flags"], "robust");
+  for (const auto& b : json["embree"]["baselines"]) EXPECT_TRUE(b["check"]["ok"].get<bool>()) << b.dump();
+  for (const auto& cell : json["cells"]) EXPECT_GT(cell["embree"]["ratio"].get<double>(), 0.0) << cell.dump();
+#endif
+  EXPECT_NE(read_text(dir.file("out/bench.md")).find("precision fast"), std::string::npos);
+}
+
 // Each bad input: a non-zero exit and one "rtcl: error:" line naming it,
 // nothing written.
 TEST(CliBench, BadInputIsOneMessageBeforeDeviceWork) {
@@ -105,6 +133,7 @@ TEST(CliBench, BadInputIsOneMessageBeforeDeviceWork) {
       {{"--scene", "soup:size=5"}, "count=N"},
       {{"--rays", "primary,caustic"}, "unknown ray set 'caustic'"},
       {{"--repeat", "0"}, "--repeat"},
+      {{"--precision", "medium"}, "--precision medium: unknown precision level"},
       {{"-o", dir.file("blocker") + "/out"}, "cannot create the directory"},
   };
   for (const Case& c : cases) {

@@ -12,9 +12,11 @@
 // RTC_BUILD_QUALITY_MEDIUM (its default). One warm-up round per scene, then
 // ROUNDS rounds, the order of the two swapped each round. Prints per scene
 // the fastest and median ms of each and their ratios (rtcl / Embree: < 1
-// means rtcl builds faster).
+// means rtcl builds faster), then the medians of rtcl's phases (validate,
+// the binary build, the flatten).
 //
 // Environment: RTCL_SCENES_DIR.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -51,19 +53,31 @@ Geometry load_scene(const std::string& name, const std::string& scenes_dir) {
   return geometry;
 }
 
-// make_bvh's build_ms path without the upload.
-double rtcl_build_ms(const Geometry& geometry, const BvhConfig& config) {
-  auto start = std::chrono::steady_clock::now();
+// ms of make_bvh's build_ms path without the upload: [0] the whole, then
+// its phases: [1] validate, [2] the binary build (build_binary_bvh: the
+// stored primitives, their boxes, the SAH build), [3] the flatten.
+std::vector<double> rtcl_build_ms(const Geometry& geometry, const BvhConfig& config) {
+  using Clock = std::chrono::steady_clock;
+  auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+  const Clock::time_point start = Clock::now();
   validate(geometry);
-  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, config), geometry, config.merge_leaves,
-                         bvh_thread_count(config));
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const Clock::time_point validated = Clock::now();
+  BuildTree tree = build_binary_bvh(geometry, config);
+  const Clock::time_point built = Clock::now();
+  Bvh8 bvh = flatten_bvh8(tree, geometry, config.merge_leaves, bvh_thread_count(config));
+  const Clock::time_point flattened = Clock::now();
   if (bvh.nodes.empty()) throw Error("empty BVH");
-  return ms;
+  return {ms(start, flattened), ms(start, validated), ms(validated, built), ms(built, flattened)};
 }
 
 double embree_build_ms(const Geometry& geometry, unsigned threads) {
   return EmbreeScene(geometry, EmbreeQuality::standard, threads).build_ms();
+}
+
+std::string format_ms(double ms) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.2f", ms);
+  return text;
 }
 
 int run(int argc, char** argv) {
@@ -82,6 +96,7 @@ int run(int argc, char** argv) {
     if (name.rfind("soup:", 0) != 0 && !find_scene_spec(name))
       throw Error("scene '" + name + "': neither a bench/ scene nor soup:N");
 
+  std::vector<std::string> phase_lines;
   std::printf("%u threads, Embree %s\n", threads, embree_version(threads).c_str());
   std::printf("| scene | triangles | rtcl ms (min / median) | Embree ms (min / median) | rtcl / Embree (min / median) |\n");
   std::printf("|---|--:|--:|--:|--:|\n");
@@ -89,21 +104,31 @@ int run(int argc, char** argv) {
     const Geometry geometry = load_scene(name, scenes_dir);
     rtcl_build_ms(geometry, config);
     embree_build_ms(geometry, threads);
-    std::vector<double> ours, theirs;
+    std::vector<double> theirs;
+    std::vector<std::vector<double>> phases(4);
+    auto ours_once = [&] {
+      std::vector<double> p = rtcl_build_ms(geometry, config);
+      for (std::size_t k = 0; k < p.size(); ++k) phases[k].push_back(p[k]);
+    };
     for (int round = 0; round < rounds; ++round) {
       if (round % 2 == 0) {
-        ours.push_back(rtcl_build_ms(geometry, config));
+        ours_once();
         theirs.push_back(embree_build_ms(geometry, threads));
       } else {
         theirs.push_back(embree_build_ms(geometry, threads));
-        ours.push_back(rtcl_build_ms(geometry, config));
+        ours_once();
       }
     }
+    const std::vector<double>& ours = phases[0];
     std::printf("| %s | %zu | %.1f / %.1f | %.1f / %.1f | %.2f / %.2f |\n", name.c_str(), geometry.triangles.size(),
                 fastest(ours), median(ours), fastest(theirs), median(theirs), fastest(ours) / fastest(theirs),
                 median(ours) / median(theirs));
     std::fflush(stdout);
+    phase_lines.push_back(name + ": validate " + format_ms(median(phases[1])) + ", binary build " +
+                          format_ms(median(phases[2])) + ", flatten " + format_ms(median(phases[3])));
   }
+  std::printf("\nrtcl's phases (medians, ms):\n");
+  for (const std::string& line : phase_lines) std::printf("  %s\n", line.c_str());
   return 0;
 }
 

@@ -207,6 +207,11 @@ BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) 
       throw UsageError("--rays " + options.rays + ": unknown ray set '" + r + "' (known: primary, shadow, diffuse)");
     m.kinds.push_back(static_cast<int>(k - std::begin(kind_names)));
   }
+  try {
+    m.precision = parse_precision(options.precision);
+  } catch (const Error& e) {
+    throw UsageError(e.what());
+  }
   m.json_path = options.output + "/bench.json";
   m.md_path = options.output + "/bench.md";
   if (create_output) {
@@ -236,6 +241,8 @@ BenchRun bench_run_header(const BenchOptions& options, const BenchMatrix& m) {
   run.size = options.size;
   run.repeat = options.repeat;
   run.check_rays = static_cast<std::size_t>(options.check_rays);
+  run.precision = std::string(precision_name(m.precision));
+  run.embree_flags = options.embree_robust ? "robust" : "none";
   run.accels = m.accels;
   for (const BenchSceneSpec& s : m.scenes) run.scenes.push_back(s.text);
   for (int k : m.kinds) run.ray_kinds.push_back(kind_names[k]);
@@ -261,17 +268,20 @@ PreparedScene prepare_bench_scene(const Device& device, const BenchSceneSpec& sp
 }
 
 std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_index, const PreparedScene& scene,
-                                       const std::string& accel_name, const std::vector<int>& kinds, int repeat) {
+                                       const std::string& accel_name, const BenchMatrix& matrix, int repeat) {
   Clock::time_point start = Clock::now();
-  std::unique_ptr<Accel> accel = make_accel(device, accel_name, scene.scene.geometry);
+  AccelConfig config;
+  config.precision = matrix.precision;
+  std::unique_ptr<Accel> accel = make_accel(device, accel_name, scene.scene.geometry, config);
   double setup = ms_since(start);
   const AccelStats& stats = accel->stats();
   std::vector<BenchCell> cells;
-  for (int k : kinds) {
+  for (int k : matrix.kinds) {
     BenchCell cell;
     cell.device = device_index;
     cell.scene = scene.info.name;
     cell.accel = accel_name;
+    cell.precision = std::string(precision_name(matrix.precision));
     cell.rays = kind_names[k];
     cell.query = kind_query(k) == Query::any ? "any" : "closest";
     cell.build_ms = stats.build_ms;
@@ -294,9 +304,9 @@ void write_bench_results(const BenchRun& run, const BenchMatrix& matrix) {
 }
 
 std::vector<BenchBaseline> bench_embree(const PreparedScene& scene, const std::vector<int>& kinds, int repeat,
-                                        unsigned threads) {
+                                        unsigned threads, bool robust) {
   std::vector<BenchBaseline> out;
-  EmbreeBaseline embree(scene.scene.geometry, threads);
+  EmbreeBaseline embree(scene.scene.geometry, threads, robust);
   const SceneRays& rays = *scene.rays;
   for (int k : kinds)
     for (bool packets : {false, true}) {
@@ -333,7 +343,10 @@ void run_bench(const BenchOptions& options) {
   } else {
     for (const DeviceInfo& info : infos) devices.push_back(Device::open(std::to_string(info.index)));
   }
-  for (const Device& device : devices) run.devices.push_back(describe_device(device));
+  for (const Device& device : devices) {
+    require_precision(device.info(), matrix.precision);
+    run.devices.push_back(describe_device(device));
+  }
   if (!options.no_embree) run.embree_version = embree_baseline_version(options.embree_threads);
 
   std::size_t total = matrix.scenes.size() * (devices.size() * matrix.accels.size() + !run.embree_version.empty()),
@@ -344,14 +357,15 @@ void run_bench(const BenchOptions& options) {
     run.scene_info.push_back(scene.info);
     if (!run.embree_version.empty()) {
       progress(done, total, scene_spec.text + " / Embree " + run.embree_version);
-      for (BenchBaseline& b : bench_embree(scene, matrix.kinds, options.repeat, options.embree_threads))
+      for (BenchBaseline& b :
+           bench_embree(scene, matrix.kinds, options.repeat, options.embree_threads, options.embree_robust))
         run.embree.push_back(std::move(b));
       ++done;
     }
     for (std::size_t d = 0; d < devices.size(); ++d)
       for (const std::string& accel_name : matrix.accels) {
         progress(done, total, scene_spec.text + " / " + accel_name + " / " + run.devices[d].name);
-        for (BenchCell& cell : bench_structure(devices[d], d, scene, accel_name, matrix.kinds, options.repeat))
+        for (BenchCell& cell : bench_structure(devices[d], d, scene, accel_name, matrix, options.repeat))
           run.cells.push_back(std::move(cell));
         ++done;
       }
@@ -386,8 +400,14 @@ void add_bench_command(CLI::App& app) {
                   "rays per set (every k-th) compared with brute force; 0: none")
       ->check(CLI::Range(0, 1 << 20))
       ->capture_default_str();
+  cmd->add_option("--precision", options->precision,
+                  "every structure's precision level: fast, robust or exact (README \"Precision levels\")")
+      ->capture_default_str();
   cmd->add_flag("--no-embree", options->no_embree,
                "leave out the Embree baseline (present when rtcl was built with Embree)");
+  cmd->add_flag("--embree-robust", options->embree_robust,
+               "build Embree's scenes with RTC_SCENE_FLAG_ROBUST (its watertight mode) instead of its default "
+               "flags: the baseline for --precision robust or exact like for like");
   cmd->add_option("--embree-threads", options->embree_threads, "host threads Embree traces and builds on")
       ->check(CLI::Range(1u, 1024u))
       ->capture_default_str();

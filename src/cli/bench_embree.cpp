@@ -25,8 +25,9 @@ struct EmbreeBaseline::Impl {
 
 std::string embree_baseline_version(unsigned threads) { return bench::embree_version(threads); }
 
-EmbreeBaseline::EmbreeBaseline(const Geometry& geometry, unsigned threads)
-    : impl_(new Impl{bench::EmbreeScene(geometry, bench::EmbreeQuality::standard, threads)}), threads_(threads) {}
+EmbreeBaseline::EmbreeBaseline(const Geometry& geometry, unsigned threads, bool robust)
+    : impl_(new Impl{bench::EmbreeScene(geometry, bench::EmbreeQuality::standard, threads, robust)}),
+      threads_(threads) {}
 
 bool EmbreeBaseline::has_packets() const { return bench::embree_has_packet8(threads_); }
 
@@ -62,7 +63,7 @@ struct EmbreeBaseline::Impl {};
 
 std::string embree_baseline_version(unsigned) { return ""; }
 
-EmbreeBaseline::EmbreeBaseline(const Geometry&, unsigned threads) : threads_(threads) {
+EmbreeBaseline::EmbreeBaseline(const Geometry&, unsigned threads, bool) : threads_(threads) {
   throw Error("rtcl was built without Embree: no Embree baseline");
 }
 

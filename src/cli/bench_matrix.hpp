@@ -12,6 +12,7 @@
 
 #include "bench_report.hpp"
 #include "bench_scenes.hpp"
+#include "rtcl/accel/precision.hpp"
 #include "rtcl/cl/device.hpp"
 
 namespace rtcl::cli {
@@ -21,7 +22,9 @@ struct BenchOptions {
   int size = 512;
   int repeat = 5;
   int check_rays = 256;
+  std::string precision = "robust";  // every structure's level (AccelConfig::precision)
   bool no_embree = false;  // without Embree built in, there is no baseline either way
+  bool embree_robust = false;  // Embree's scenes with RTC_SCENE_FLAG_ROBUST
   unsigned embree_threads = std::max(1u, std::thread::hardware_concurrency());
 };
 
@@ -30,6 +33,7 @@ struct BenchMatrix {
   std::vector<std::string> accels;
   std::vector<BenchSceneSpec> scenes;
   std::vector<int> kinds;  // 0 primary, 1 shadow, 2 diffuse
+  Precision precision = Precision::robust;
   std::string json_path, md_path;
 };
 
@@ -53,16 +57,16 @@ struct PreparedScene {
 };
 PreparedScene prepare_bench_scene(const Device& device, const BenchSceneSpec& spec, const BenchOptions& options);
 
-// One structure over one scene on one device: a cell per ray kind, with
-// `device_index` as the cell's device.
+// One structure over one scene on one device at the matrix's precision
+// level: a cell per ray kind, with `device_index` as the cell's device.
 std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_index, const PreparedScene& scene,
-                                       const std::string& accel, const std::vector<int>& kinds, int repeat);
+                                       const std::string& accel, const BenchMatrix& matrix, int repeat);
 
 // Embree's figures on the scene's ray sets (single rays, and 8-ray packets
 // where Embree traces them natively), checked like the cells; needs rtcl
 // built with Embree (embree_baseline_version() not empty).
 std::vector<BenchBaseline> bench_embree(const PreparedScene& scene, const std::vector<int>& kinds, int repeat,
-                                        unsigned threads);
+                                        unsigned threads, bool robust);
 
 // bench.json and bench.md, each written whole or not at all; the table on
 // stdout.

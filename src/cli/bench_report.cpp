@@ -67,6 +67,7 @@ json cell_json(const BenchCell& c, const BenchBaseline* baseline) {
       {"scene", c.scene},
       {"accel", c.accel},
       {"rays", c.rays},
+      {"precision", c.precision},
       {"query", c.query},
       {"ray_count", c.ray_count},
       {"build_ms", c.build_ms},
@@ -113,7 +114,7 @@ std::string bench_json(const BenchRun& run) {
   if (!run.embree_version.empty()) {
     json baselines = json::array();
     for (const BenchBaseline& b : run.embree) baselines.push_back(baseline_json(b));
-    embree = {{"version", run.embree_version}, {"baselines", baselines}};
+    embree = {{"version", run.embree_version}, {"flags", run.embree_flags}, {"baselines", baselines}};
   }
   json out = {
       {"schema", "rtcl-bench/1"},
@@ -122,6 +123,7 @@ std::string bench_json(const BenchRun& run) {
       {"started_utc", run.started_utc},
       {"options", {{"size", run.size}, {"repeat", run.repeat}, {"check_rays", run.check_rays},
                    {"accel", run.accels}, {"scene", run.scenes}, {"rays", run.ray_kinds},
+                   {"precision", run.precision}, {"embree_flags", run.embree_flags},
                    {"pocl_cache_dir", run.pocl_cache_dir}}},
       {"devices", devices},
       {"scenes", scenes},
@@ -152,11 +154,12 @@ std::string bench_markdown(const BenchRun& run) {
   std::string md = "rtcl " + run.rtcl_commit + ", " + run.host_cpu + " (" + std::to_string(run.host_threads) +
                    " threads), " + std::to_string(run.size) + "x" + std::to_string(run.size) +
                    " rays per primary set, median (min - max) Mrays/s of " + std::to_string(run.repeat) +
-                   " kernel launches after a warm-up (OpenCL event times); build: host ms; B/prim: device bytes per "
-                   "primitive; check: rays agreeing with brute force" +
+                   " kernel launches after a warm-up (OpenCL event times), precision " + run.precision +
+                   "; build: host ms; B/prim: device bytes per primitive; check: rays agreeing with brute force" +
                    (run.embree_version.empty()
                         ? std::string(".\n")
                         : "; xE: ratio to Embree " + run.embree_version +
+                              (run.embree_flags == "robust" ? " (RTC_SCENE_FLAG_ROBUST)" : " (default flags)") +
                               " on the same rays (its traversal time on the host threads; packet kernels against "
                               "rtcIntersect8 / rtcOccluded8).\n");
   for (std::size_t d = 0; d < run.devices.size(); ++d) {

@@ -18,6 +18,7 @@ Spread spread_of(std::vector<double> values);  // all 0 for no values
 struct BenchCell {
   std::size_t device = 0;  // index into BenchRun::devices
   std::string scene, accel, rays, query;  // rays: primary | shadow | diffuse; query: closest | any
+  std::string precision;                  // fast | robust | exact
   std::size_t ray_count = 0;
   double build_ms = 0.0;       // host build (AccelStats::build_ms)
   // make_accel's wall time less build_ms: the upload and the closest-hit
@@ -70,6 +71,8 @@ struct BenchRun {
   unsigned host_threads = 0;
   int size = 0, repeat = 0;
   std::size_t check_rays = 0;
+  std::string precision;     // the structures' level: fast | robust | exact
+  std::string embree_flags;  // Embree's scene flags: none (its default) | robust
   std::vector<std::string> accels, scenes, ray_kinds;
   std::vector<BenchDevice> devices;
   std::vector<BenchSceneInfo> scene_info;

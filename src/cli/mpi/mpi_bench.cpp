@@ -23,6 +23,7 @@ namespace {
 
 nlohmann::json cell_json(const BenchCell& c) {
   return {{"scene", c.scene},       {"accel", c.accel},         {"rays", c.rays},
+          {"precision", c.precision}, {"packets", c.packets},
           {"query", c.query},       {"ray_count", c.ray_count}, {"build_ms", c.build_ms},
           {"setup_ms", c.setup_ms}, {"first_launch_ms", c.first_launch_ms},
           {"device_bytes", c.device_bytes}, {"primitives", c.primitives},
@@ -36,6 +37,8 @@ BenchCell cell_of(const nlohmann::json& j, std::size_t device) {
   c.scene = j["scene"];
   c.accel = j["accel"];
   c.rays = j["rays"];
+  c.precision = j["precision"];
+  c.packets = j["packets"];
   c.query = j["query"];
   c.ray_count = j["ray_count"];
   c.build_ms = j["build_ms"];
@@ -104,7 +107,7 @@ void run(const MpiWorld& world, const BenchOptions& options) {
       scene_index = s;
     }
     nlohmann::json out{{"scene", scene_json(scene->info)}, {"cells", nlohmann::json::array()}};
-    for (const BenchCell& c : bench_structure(*device, 0, *scene, m.accels[a], m.kinds, options.repeat))
+    for (const BenchCell& c : bench_structure(*device, 0, *scene, m.accels[a], m, options.repeat))
       out["cells"].push_back(cell_json(c));
     return as_bytes(out.dump());
   };

@@ -114,17 +114,17 @@ struct EmbreeScene::Buffers {
   std::vector<std::uint32_t> indices;
 };
 
-EmbreeScene::EmbreeScene(const Geometry& geometry, EmbreeQuality quality, unsigned threads)
+EmbreeScene::EmbreeScene(const Geometry& geometry, EmbreeQuality quality, unsigned threads, bool robust)
     : buffers_(new Buffers) {
   try {
-    build(geometry, quality, threads);
+    build(geometry, quality, threads, robust);
   } catch (...) {
     release();
     throw;
   }
 }
 
-void EmbreeScene::build(const Geometry& geometry, EmbreeQuality quality, unsigned threads) {
+void EmbreeScene::build(const Geometry& geometry, EmbreeQuality quality, unsigned threads, bool robust) {
   RTCDevice device = embree_device(threads);
   buffers_->vertices.reserve(3 * geometry.vertices.size() + 1);
   for (const glm::vec3& v : geometry.vertices) buffers_->vertices.insert(buffers_->vertices.end(), {v.x, v.y, v.z});
@@ -137,7 +137,7 @@ void EmbreeScene::build(const Geometry& geometry, EmbreeQuality quality, unsigne
   RTCScene scene = rtcNewScene(device);
   check_embree(device, "rtcNewScene");
   scene_ = scene;
-  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
+  rtcSetSceneFlags(scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
   rtcSetSceneBuildQuality(scene, quality == EmbreeQuality::high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
   RTCGeometry mesh = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   rtcSetSharedGeometryBuffer(mesh, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, buffers_->vertices.data(), 0,

@@ -29,11 +29,13 @@ const char* embree_api_name(EmbreeApi api, Query query);  // e.g. "rtcIntersect8
 
 class EmbreeScene {
  public:
-  // Builds a scene (RTC_SCENE_FLAG_NONE) with one triangle mesh; primID is the
-  // triangle index. `threads`: Embree's build threads (the first scene's
-  // count configures the process's one Embree device). Throws Error with
-  // Embree's error code on failure.
-  EmbreeScene(const Geometry& geometry, EmbreeQuality quality, unsigned threads);
+  // Builds a scene with one triangle mesh; primID is the triangle index.
+  // `threads`: Embree's build threads (the first scene's count configures
+  // the process's one Embree device). `robust`: RTC_SCENE_FLAG_ROBUST
+  // (Embree's watertight mode, "avoid optimizations that reduce arithmetic
+  // accuracy"), else RTC_SCENE_FLAG_NONE, Embree's default. Throws Error
+  // with Embree's error code on failure.
+  EmbreeScene(const Geometry& geometry, EmbreeQuality quality, unsigned threads, bool robust = false);
   ~EmbreeScene();
   EmbreeScene(const EmbreeScene&) = delete;
   EmbreeScene& operator=(const EmbreeScene&) = delete;
@@ -62,7 +64,7 @@ class EmbreeScene {
   void answers(Hit* hits) const;
 
  private:
-  void build(const Geometry& geometry, EmbreeQuality quality, unsigned threads);
+  void build(const Geometry& geometry, EmbreeQuality quality, unsigned threads, bool robust);
   void release();
   struct Buffers;
   struct Prepared;
