@@ -154,6 +154,47 @@ TEST(BvhPacket, MatchesReferenceOnIncoherentRaysWithSpheres) {
   expect_same_as_single_ray(*single, *packet, rays, "soup with spheres");
 }
 
+// Packets whose rays share one direction octant take the frustum
+// traversal (one box test per node for the whole packet): loose frusta
+// (origins spread over the scene), tight ones, rays aimed exactly at mesh
+// vertices (which lie on leaf box faces), triangles beside spheres, an
+// invalid ray in an otherwise frustum-shaped packet; answers as the
+// single-ray kernel's and the double-precision reference's.
+TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
+  Geometry g = random_soup(1500, 91);
+  std::mt19937 rng(92);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int i = 0; i < 100; ++i) g.spheres.push_back({{unit(rng), unit(rng), unit(rng)}, 0.005f + 0.03f * unit(rng)});
+  auto packet = make_accel(test_device(), "bvh-packet", g);
+  auto single = make_accel(test_device(), "bvh", g);
+  std::vector<Ray> rays;
+  for (int p = 0; p < 240; ++p) {
+    glm::vec3 sign(unit(rng) < 0.5f ? -1.0f : 1.0f, unit(rng) < 0.5f ? -1.0f : 1.0f, unit(rng) < 0.5f ? -1.0f : 1.0f);
+    float spread = p % 3 == 0 ? 1.0f : p % 3 == 1 ? 0.05f : 0.0f;  // origins: whole scene, a patch, one point
+    glm::vec3 centre(unit(rng), unit(rng), unit(rng));
+    for (int l = 0; l < 8; ++l) {
+      glm::vec3 d = sign * glm::vec3(0.05f + unit(rng), 0.05f + unit(rng), 0.05f + unit(rng));
+      glm::vec3 o;
+      if (p % 4 == 3) {  // aimed at a vertex from 2 units away
+        glm::vec3 v = g.vertices[static_cast<std::size_t>(unit(rng) * static_cast<float>(g.vertices.size() - 1))];
+        d = glm::normalize(d);
+        o = v - 2.0f * d;
+      } else {
+        o = centre - 1.5f * sign + spread * glm::vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f);
+      }
+      rays.push_back({o.x, o.y, o.z, d.x, d.y, d.z, 0.0f, kInf});
+    }
+  }
+  rays[8 * 5 + 3].dx = kNaN;  // inactive lane in a frustum packet
+  rays.resize(rays.size() - 3);  // a partial last packet
+  for (Query q : {Query::closest, Query::any}) {
+    std::size_t failures = 0;
+    auto report = judge_all(g, rays, run_query(*packet, rays, q), q, &failures);
+    EXPECT_EQ(failures, 0u) << (q == Query::closest ? "closest: " : "any: ") << (report.empty() ? "" : report[0]);
+  }
+  expect_same_as_single_ray(*single, *packet, rays, "one-octant packets");
+}
+
 // Invalid rays share packets with valid ones; counts 1 .. 17 leave partial
 // packets; the hits past ray_count stay untouched.
 TEST(BvhPacket, PartialPacketsAndInvalidRaysInAPacket) {

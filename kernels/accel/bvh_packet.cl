@@ -20,6 +20,10 @@
  *
  * Stack bound: as in accel/bvh.cl (a node pushes at most its children and
  * pops one), so the host's RTCL_STACK_SIZE is valid here too. */
+/* The frustum traversal's stack holds child slots (8 * node + lane), so
+ * that a leaf's rays can be tested against its own box. */
+#define RTCL_BVH8_ENTRY(k) (8 * ref + (k))
+#include "shared/bvh8_stack.h"
 #include "shared/packet.h"
 
 #ifndef RTCL_STACK_SIZE
@@ -47,11 +51,144 @@ inline int8 packet_triangle(global const TriangleBlock* block, int k, const Trac
   return packet_triangle_at(&block->v[0][0][k], RTCL_BLOCK_WIDTH, block->prim[k], p, h, mask);
 }
 
-/* Traverses the packet. Any hit: a ray leaves the packet at its first hit;
- * the traversal ends when every ray has. */
+/* The leaf `leaf` (a node reference's complement) against the packet's
+ * rays in `mask`. Any hit: the rays that hit leave `alive` and `mask`. */
+inline void packet_leaf(int leaf, const TracePacket* p, PacketHits* h, global const TriangleBlock* triangles,
+                        global const SphereBlock* spheres, int8* alive, int8* mask) {
+#ifdef RTCL_HAS_SPHERES
+  if (leaf & 1) {
+    global const SphereBlock* block = spheres + (leaf >> 1);
+    for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
+      if (block->prim[k] < 0) continue;
+      int8 hit = packet_sphere(block, k, p, h, *mask);
+      if (RTCL_ANY_HIT) {
+        *alive &= ~hit;
+        *mask &= ~hit;
+      }
+    }
+    return;
+  }
+#endif
+  global const TriangleBlock* block = triangles + (leaf >> 1);
+  for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
+    if (block->prim[k] < 0) continue;
+    int8 hit = packet_triangle(block, k, p, h, *mask);
+    if (RTCL_ANY_HIT) {
+      *alive &= ~hit;
+      *mask &= ~hit;
+    }
+  }
+}
+
+/* The packet as one frustum (after Embree's traversal of coherent
+ * packets): when its active rays move the same way along each axis (one
+ * direction octant) and have finite reciprocals, a node's eight child
+ * boxes are tested against bounds of all its rays at once
+ * (rtcl_frustum_slabs8: the origins' box, the reciprocals' range), one
+ * float8 test per node as for a single ray, where the per-ray traversal
+ * tests each child against the eight rays in turn. The test is
+ * conservative (a box it rejects no ray enters), leaves test every ray
+ * with its own arithmetic, and a ray's closest hit does not depend on
+ * which extra boxes were visited: the hits are the per-ray traversal's.
+ * Children are pushed nearest first by the frustum's entry distance
+ * (shared/bvh8_stack.h, as accel/bvh.cl); an entry beyond every ray's
+ * current best hit is skipped. */
+typedef struct PacketFrustum {
+  float onx, ony, onz;          /* origin bound for the entry planes */
+  float ofx, ofy, ofz;          /* ... for the exit planes */
+  float lx, ly, lz, hx, hy, hz; /* reciprocal direction range per axis */
+  float tmin;                   /* the active rays' smallest tmin */
+  int near_x, near_y, near_z, far_x, far_y, far_z; /* bounds rows, as in TraceRay */
+} PacketFrustum;
+
+inline float packet_min(float8 v, int8 lanes) { return rtcl_min8(select((float8)(INFINITY), v, lanes)); }
+inline float packet_max(float8 v, int8 lanes) { return rtcl_max8(select((float8)(-INFINITY), v, lanes)); }
+
+/* Fills *f and returns 1 when the packet's active rays share a direction
+ * octant and have finite reciprocals, else returns 0. */
+inline int packet_frustum(const TracePacket* p, PacketFrustum* f) {
+  int8 a = p->active;
+  int8 finite = (fabs(p->ix) < INFINITY) & (fabs(p->iy) < INFINITY) & (fabs(p->iz) < INFINITY);
+  if (rtcl_any8(a & ~finite)) return 0;
+  int pos_x = rtcl_any8(a & p->pos_x), pos_y = rtcl_any8(a & p->pos_y), pos_z = rtcl_any8(a & p->pos_z);
+  if ((pos_x && rtcl_any8(a & ~p->pos_x)) || (pos_y && rtcl_any8(a & ~p->pos_y)) ||
+      (pos_z && rtcl_any8(a & ~p->pos_z)))
+    return 0;
+  float ox_lo = packet_min(p->ox, a), ox_hi = packet_max(p->ox, a);
+  float oy_lo = packet_min(p->oy, a), oy_hi = packet_max(p->oy, a);
+  float oz_lo = packet_min(p->oz, a), oz_hi = packet_max(p->oz, a);
+  f->onx = pos_x ? ox_hi : ox_lo;
+  f->ofx = pos_x ? ox_lo : ox_hi;
+  f->ony = pos_y ? oy_hi : oy_lo;
+  f->ofy = pos_y ? oy_lo : oy_hi;
+  f->onz = pos_z ? oz_hi : oz_lo;
+  f->ofz = pos_z ? oz_lo : oz_hi;
+  f->lx = packet_min(p->ix, a);
+  f->hx = packet_max(p->ix, a);
+  f->ly = packet_min(p->iy, a);
+  f->hy = packet_max(p->iy, a);
+  f->lz = packet_min(p->iz, a);
+  f->hz = packet_max(p->iz, a);
+  f->tmin = packet_min(p->tmin, a);
+  f->near_x = pos_x ? 0 : 3;
+  f->near_y = pos_y ? 1 : 4;
+  f->near_z = pos_z ? 2 : 5;
+  f->far_x = 3 - f->near_x;
+  f->far_y = 5 - f->near_y;
+  f->far_z = 7 - f->near_z;
+  return 1;
+}
+
+__attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const PacketFrustum* f, PacketHits* h,
+                                                    global const Bvh8Node* nodes,
+                                                    global const TriangleBlock* triangles,
+                                                    global const SphereBlock* spheres) {
+  int stack_ref[RTCL_STACK_SIZE]; /* child slots: 8 * node + lane */
+  float stack_t[RTCL_STACK_SIZE]; /* the frustum's entry distance of the slot's box */
+  int sp = 0;
+  int ref = 0, slot = 0;
+  int8 alive = p->active; /* any hit: rays still looking */
+  for (;;) {
+    if (ref >= 0) {
+      global const Bvh8Node* node = nodes + ref;
+      global const float8* b = (global const float8*)node->bounds;
+      float8 t_entry, t_exit;
+      rtcl_frustum_slabs8(b[f->near_x], b[f->near_y], b[f->near_z], b[f->far_x], b[f->far_y], b[f->far_z], f->onx,
+                          f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->lx, f->ly, f->lz, f->hx, f->hy, f->hz, f->tmin,
+                          packet_max(h->t_best, alive), &t_entry, &t_exit);
+      int8 hit = t_entry <= t_exit;
+      if (rtcl_any8(hit)) {
+        RTCL_BVH8_PUSH_CHILDREN
+      }
+    } else {
+      /* the rays that enter the leaf's own box, as the per-ray traversal has them */
+      float8 tn = packet_box(nodes + (slot >> 3), slot & 7, p, h->t_best, alive);
+      int8 mask = tn == tn;
+      if (rtcl_any8(mask)) {
+        packet_leaf(~ref, p, h, triangles, spheres, &alive, &mask);
+        if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
+      }
+    }
+    do {
+      if (sp == 0) return;
+      --sp;
+    } while (!RTCL_ANY_HIT && stack_t[sp] > packet_max(h->t_best, alive));
+    slot = stack_ref[sp];
+    ref = nodes[slot >> 3].child[slot & 7];
+  }
+}
+
+/* Traverses the packet: as one frustum when packet_frustum allows, else
+ * ray by ray in the lanes. Any hit: a ray leaves the packet at its first
+ * hit; the traversal ends when every ray has. */
 __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketHits* h, global const Bvh8Node* nodes,
                                                    global const TriangleBlock* triangles,
                                                    global const SphereBlock* spheres) {
+  PacketFrustum frustum;
+  if (packet_frustum(p, &frustum)) {
+    bvh_frustum_traverse(p, &frustum, h, nodes, triangles, spheres);
+    return;
+  }
   float8 stack_t[RTCL_STACK_SIZE]; /* entry distances of stack_ref's box, NaN: ray not in it */
   int stack_ref[RTCL_STACK_SIZE];
   float stack_key[RTCL_STACK_SIZE]; /* nearest entry distance over the packet: visiting order */
@@ -83,31 +220,7 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
         stack_ref[j] = child;
       }
     } else {
-      int leaf = ~ref;
-#ifdef RTCL_HAS_SPHERES
-      if (leaf & 1) {
-        global const SphereBlock* block = spheres + (leaf >> 1);
-        for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
-          if (block->prim[k] < 0) continue;
-          int8 hit = packet_sphere(block, k, p, h, mask);
-          if (RTCL_ANY_HIT) {
-            alive &= ~hit;
-            mask &= ~hit;
-          }
-        }
-      } else
-#endif
-      {
-        global const TriangleBlock* block = triangles + (leaf >> 1);
-        for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
-          if (block->prim[k] < 0) continue;
-          int8 hit = packet_triangle(block, k, p, h, mask);
-          if (RTCL_ANY_HIT) {
-            alive &= ~hit;
-            mask &= ~hit;
-          }
-        }
-      }
+      packet_leaf(~ref, p, h, triangles, spheres, &alive, &mask);
       if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
     }
     /* pop the next entry some ray still needs: entered before its best hit */

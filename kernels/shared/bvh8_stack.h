@@ -10,6 +10,12 @@
 #ifndef RTCL_SHARED_BVH8_STACK_H
 #define RTCL_SHARED_BVH8_STACK_H
 
+/* What is pushed for lane k: the child reference, unless the kernel says
+ * otherwise (the packet kernel's frustum traversal pushes child slots). */
+#ifndef RTCL_BVH8_ENTRY
+#define RTCL_BVH8_ENTRY(k) node->child[k]
+#endif
+
 #define RTCL_BVH8_PUSH_LANE(k)                                \
   if (hit.s##k) {                                             \
     float t = t_entry.s##k;                                   \
@@ -20,7 +26,7 @@
       --j;                                                    \
     }                                                         \
     if (!RTCL_ANY_HIT) stack_t[j] = t;                        \
-    stack_ref[j] = node->child[k];                            \
+    stack_ref[j] = RTCL_BVH8_ENTRY(k);                        \
   }
 
 /* Needs in scope: int8 hit, float8 t_entry, node, stack_t, stack_ref, sp. */
