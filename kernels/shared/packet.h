@@ -178,6 +178,8 @@ inline int8 packet_triangle_at(global const float* at, int stride, int prim, con
   }
   return vload8(0, hit);
 #else
+  /* most of a packet's triangle tests find no ray inside the edges: no division then */
+  if (!rtcl_any8(mask & rtcl_watertight_inside8(&wt))) return (int8)(0);
   float8 t, det;
   int8 ok = mask & rtcl_watertight_hit8(&wt, p->sz, p->tmin, h->t_best, &t, &det);
   if (!rtcl_any8(ok)) return ok;

@@ -82,15 +82,20 @@ RTCL_LANES_INLINE Watertight8 rtcl_watertight_edges8(float8 ax, float8 ay, float
   return w;
 }
 
+/* The lanes inside all three edges of rtcl_watertight_edges8, either
+ * winding (a lane with a NaN edge may pass; its det and t are NaN and fail
+ * rtcl_watertight_hit8's t test). */
+RTCL_LANES_INLINE int8 rtcl_watertight_inside8(const Watertight8* w) {
+  return (rtcl_fmin8(w->U, rtcl_fmin8(w->V, w->W)) >= 0.0f) | (rtcl_fmax8(w->U, rtcl_fmax8(w->V, w->W)) <= 0.0f);
+}
+
 /* The robust level's decision from rtcl_watertight_edges8: the lanes hit
  * in [tmin, t_best) (inside all three edges, either winding; not in the
  * triangle's plane), with the hit distance *t and the determinant *det
  * (barycentrics V / det, W / det). */
 RTCL_LANES_INLINE int8 rtcl_watertight_hit8(const Watertight8* w, float8 sz, float8 tmin, float8 t_best,
                                             float8* t, float8* det) {
-  /* a lane with a NaN edge may pass; its det and t are NaN and fail the t test */
-  int8 inside = (rtcl_fmin8(w->U, rtcl_fmin8(w->V, w->W)) >= 0.0f) |
-                (rtcl_fmax8(w->U, rtcl_fmax8(w->V, w->W)) <= 0.0f);
+  int8 inside = rtcl_watertight_inside8(w);
   *det = w->U + w->V + w->W;
   float8 T = sz * (w->U * w->Az + w->V * w->Bz + w->W * w->Cz);
   *t = T / *det;
