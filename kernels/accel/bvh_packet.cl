@@ -51,35 +51,6 @@ inline int8 packet_triangle(global const TriangleBlock* block, int k, const Trac
   return packet_triangle_at(&block->v[0][0][k], RTCL_BLOCK_WIDTH, block->prim[k], p, h, mask);
 }
 
-/* The leaf `leaf` (a node reference's complement) against the packet's
- * rays in `mask`. Any hit: the rays that hit leave `alive` and `mask`. */
-inline void packet_leaf(int leaf, const TracePacket* p, PacketHits* h, global const TriangleBlock* triangles,
-                        global const SphereBlock* spheres, int8* alive, int8* mask) {
-#ifdef RTCL_HAS_SPHERES
-  if (leaf & 1) {
-    global const SphereBlock* block = spheres + (leaf >> 1);
-    for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
-      if (block->prim[k] < 0) continue;
-      int8 hit = packet_sphere(block, k, p, h, *mask);
-      if (RTCL_ANY_HIT) {
-        *alive &= ~hit;
-        *mask &= ~hit;
-      }
-    }
-    return;
-  }
-#endif
-  global const TriangleBlock* block = triangles + (leaf >> 1);
-  for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
-    if (block->prim[k] < 0) continue;
-    int8 hit = packet_triangle(block, k, p, h, *mask);
-    if (RTCL_ANY_HIT) {
-      *alive &= ~hit;
-      *mask &= ~hit;
-    }
-  }
-}
-
 /* The packet as one frustum (after Embree's traversal of coherent
  * packets): when its active rays move the same way along each axis (one
  * direction octant) and have finite reciprocals, a node's eight child
@@ -139,6 +110,61 @@ inline int packet_frustum(const TracePacket* p, PacketFrustum* f) {
   return 1;
 }
 
+/* The triangles of a block whose boxes the frustum meets (a bit per lane):
+ * their boxes, from the block's own vertex rows (min / max: exact), under
+ * the node boxes' test, so no triangle a ray of the packet hits is left
+ * out. */
+inline int frustum_triangles(global const TriangleBlock* block, const PacketFrustum* f, float tmax) {
+  float8 lo[3], hi[3];
+  for (int a = 0; a < 3; ++a) {
+    float8 v0 = vload8(0, block->v[0][a]), v1 = vload8(0, block->v[1][a]), v2 = vload8(0, block->v[2][a]);
+    lo[a] = fmin(v0, fmin(v1, v2));
+    hi[a] = fmax(v0, fmax(v1, v2));
+  }
+  float8 tn, tf;
+  rtcl_frustum_slabs8(f->near_x == 0 ? lo[0] : hi[0], f->near_y == 1 ? lo[1] : hi[1], f->near_z == 2 ? lo[2] : hi[2],
+                      f->near_x == 0 ? hi[0] : lo[0], f->near_y == 1 ? hi[1] : lo[1], f->near_z == 2 ? hi[2] : lo[2],
+                      f->onx, f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->lx, f->ly, f->lz, f->hx, f->hy, f->hz,
+                      f->tmin, tmax, &tn, &tf);
+  int8 bits = ((tn <= tf) & (vload8(0, block->prim) >= 0)) & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
+  int4 o4 = bits.lo | bits.hi;
+  int2 o2 = o4.lo | o4.hi;
+  return o2.lo | o2.hi;
+}
+
+/* The leaf `leaf` (a node reference's complement) against the packet's
+ * rays in `mask`; with a frustum (else null), only the triangles whose
+ * boxes it meets. Any hit: the rays that hit leave `alive` and `mask`. */
+inline void packet_leaf(int leaf, const TracePacket* p, const PacketFrustum* f, PacketHits* h,
+                        global const TriangleBlock* triangles, global const SphereBlock* spheres, int8* alive,
+                        int8* mask) {
+#ifdef RTCL_HAS_SPHERES
+  if (leaf & 1) {
+    global const SphereBlock* block = spheres + (leaf >> 1);
+    for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
+      if (block->prim[k] < 0) continue;
+      int8 hit = packet_sphere(block, k, p, h, *mask);
+      if (RTCL_ANY_HIT) {
+        *alive &= ~hit;
+        *mask &= ~hit;
+      }
+    }
+    return;
+  }
+#endif
+  global const TriangleBlock* block = triangles + (leaf >> 1);
+  int lanes = 0xff;
+  if (f) lanes = frustum_triangles(block, f, packet_max(h->t_best, *mask));
+  for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
+    if (!(lanes >> k & 1) || block->prim[k] < 0) continue;
+    int8 hit = packet_triangle(block, k, p, h, *mask);
+    if (RTCL_ANY_HIT) {
+      *alive &= ~hit;
+      *mask &= ~hit;
+    }
+  }
+}
+
 __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const PacketFrustum* f, PacketHits* h,
                                                     global const Bvh8Node* nodes,
                                                     global const TriangleBlock* triangles,
@@ -165,7 +191,7 @@ __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const 
       float8 tn = packet_box(nodes + (slot >> 3), slot & 7, p, h->t_best, alive);
       int8 mask = tn == tn;
       if (rtcl_any8(mask)) {
-        packet_leaf(~ref, p, h, triangles, spheres, &alive, &mask);
+        packet_leaf(~ref, p, f, h, triangles, spheres, &alive, &mask);
         if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
       }
     }
@@ -220,7 +246,7 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
         stack_ref[j] = child;
       }
     } else {
-      packet_leaf(~ref, p, h, triangles, spheres, &alive, &mask);
+      packet_leaf(~ref, p, 0, h, triangles, spheres, &alive, &mask);
       if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
     }
     /* pop the next entry some ray still needs: entered before its best hit */
