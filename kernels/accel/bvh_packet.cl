@@ -174,6 +174,7 @@ __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const 
   int sp = 0;
   int ref = 0, slot = 0;
   int8 alive = p->active; /* any hit: rays still looking */
+  float t_far = packet_max(h->t_best, alive); /* beyond every alive ray's best hit: changes at leaves only */
   for (;;) {
     if (ref >= 0) {
       global const Bvh8Node* node = nodes + ref;
@@ -181,7 +182,7 @@ __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const 
       float8 t_entry, t_exit;
       rtcl_frustum_slabs8(b[f->near_x], b[f->near_y], b[f->near_z], b[f->far_x], b[f->far_y], b[f->far_z], f->onx,
                           f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->lx, f->ly, f->lz, f->hx, f->hy, f->hz, f->tmin,
-                          packet_max(h->t_best, alive), &t_entry, &t_exit);
+                          t_far, &t_entry, &t_exit);
       int8 hit = t_entry <= t_exit;
       if (rtcl_any8(hit)) {
         RTCL_BVH8_PUSH_CHILDREN
@@ -193,12 +194,13 @@ __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const 
       if (rtcl_any8(mask)) {
         packet_leaf(~ref, p, f, h, triangles, spheres, &alive, &mask);
         if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
+        t_far = packet_max(h->t_best, alive);
       }
     }
     do {
       if (sp == 0) return;
       --sp;
-    } while (!RTCL_ANY_HIT && stack_t[sp] > packet_max(h->t_best, alive));
+    } while (!RTCL_ANY_HIT && stack_t[sp] > t_far);
     slot = stack_ref[sp];
     ref = nodes[slot >> 3].child[slot & 7];
   }
