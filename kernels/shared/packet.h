@@ -33,33 +33,50 @@ inline float8 rtcl_pick_axis(float8 x, float8 y, float8 z, int8 k1, int8 k2) {
   return select(select(x, y, k1), z, k2);
 }
 
+/* Eight Ray records as eight rows of eight floats, transposed into the
+ * fields' lanes: out[f] lane l = field f of ray l. */
+inline void rtcl_transpose8(const float8 r[8], float8 out[8]) {
+  const uint8 lo = (uint8)(0, 8, 1, 9, 4, 12, 5, 13), hi = (uint8)(2, 10, 3, 11, 6, 14, 7, 15);
+  const uint8 lo2 = (uint8)(0, 1, 8, 9, 4, 5, 12, 13), hi2 = (uint8)(2, 3, 10, 11, 6, 7, 14, 15);
+  const uint8 lo4 = (uint8)(0, 1, 2, 3, 8, 9, 10, 11), hi4 = (uint8)(4, 5, 6, 7, 12, 13, 14, 15);
+  float8 a[8], b[8];
+  for (int k = 0; k < 8; k += 2) {
+    a[k] = shuffle2(r[k], r[k + 1], lo);
+    a[k + 1] = shuffle2(r[k], r[k + 1], hi);
+  }
+  for (int k = 0; k < 8; k += 4) {
+    b[k] = shuffle2(a[k], a[k + 2], lo2);      /* fields 0 | 4 of rays k .. k+3 */
+    b[k + 1] = shuffle2(a[k], a[k + 2], hi2);  /* fields 1 | 5 */
+    b[k + 2] = shuffle2(a[k + 1], a[k + 3], lo2); /* fields 2 | 6 */
+    b[k + 3] = shuffle2(a[k + 1], a[k + 3], hi2); /* fields 3 | 7 */
+  }
+  for (int f = 0; f < 4; ++f) {
+    out[f] = shuffle2(b[f], b[f + 4], lo4);
+    out[f + 4] = shuffle2(b[f], b[f + 4], hi4);
+  }
+}
+
 inline void packet_setup(global const Ray* rays, uint first, uint ray_count, TracePacket* p, float8* tmax) {
-  float lanes[8][8];  /* [field][lane] */
-  int valid[8];
+  float8 field[8]; /* ox, oy, oz, dx, dy, dz, tmin, tmax: the Ray layout */
+  float8 row[8];
   for (int l = 0; l < 8; ++l) {
     uint i = first + (uint)l;
-    Ray r;
     if (i < ray_count) {
-      r = rays[i];
+      row[l] = vload8(i, (global const float*)rays);
     } else { /* padding: an untraceable ray (zero direction) */
-      r.ox = r.oy = r.oz = r.dx = r.dy = r.dz = 0.0f;
-      r.tmin = 0.0f;
-      r.tmax = -1.0f;
+      row[l] = (float8)(0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, -1.0f);
     }
-    lanes[0][l] = r.ox; lanes[1][l] = r.oy; lanes[2][l] = r.oz;
-    lanes[3][l] = r.dx; lanes[4][l] = r.dy; lanes[5][l] = r.dz;
-    lanes[6][l] = r.tmin; lanes[7][l] = r.tmax;
-    valid[l] = -rtcl_ray_valid(r.ox, r.oy, r.oz, r.dx, r.dy, r.dz, r.tmin, r.tmax);
   }
-  float8 ox = vload8(0, lanes[0]), oy = vload8(0, lanes[1]), oz = vload8(0, lanes[2]);
-  float8 dx = vload8(0, lanes[3]), dy = vload8(0, lanes[4]), dz = vload8(0, lanes[5]);
-  float8 tmin = vload8(0, lanes[6]);
-  *tmax = vload8(0, lanes[7]);
+  rtcl_transpose8(row, field);
+  float8 ox = field[0], oy = field[1], oz = field[2];
+  float8 dx = field[3], dy = field[4], dz = field[5];
+  float8 tmin = field[6];
+  *tmax = field[7];
   float8 ax = fabs(dx), ay = fabs(dy), az = fabs(dz);
   /* kz = dominant axis, ties as in trace_ray_setup */
   int8 kz = select(select((int8)(2), (int8)(1), ay > az), select((int8)(2), (int8)(0), ax > az), ax > ay);
   float8 adk = select(select(az, ay, kz == 1), ax, kz == 0);
-  p->active = (adk > 0.0f) & vload8(0, valid);
+  p->active = (adk > 0.0f) & rtcl_ray_valid8(ox, oy, oz, dx, dy, dz, tmin, *tmax);
   p->tmax = *tmax;
   int8 kx = select(kz + 1, (int8)(0), kz == 2);
   int8 ky = select(kx + 1, (int8)(0), kx == 2);

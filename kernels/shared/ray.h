@@ -56,11 +56,24 @@ inline int rtcl_is_nan(float x) { return (as_uint(x) & 0x7fffffffu) > 0x7f800000
 /* The invalid-ray rule (README, "Invalid rays"): NaN or ±inf in any origin
  * or direction component, a zero direction, a NaN tmin or tmax, or
  * tmin > tmax: the ray reports a miss. */
+/* The rule as one expression over scalars (AS_UINT = as_uint: 1 where
+ * valid) or vectors (as_uint8: -1 in the valid lanes). */
+#define RTCL_RAY_VALID(AS_UINT, ox, oy, oz, dx, dy, dz, tmin, tmax)                                          \
+  (((AS_UINT(ox) & 0x7f800000u) != 0x7f800000u) & ((AS_UINT(oy) & 0x7f800000u) != 0x7f800000u) &           \
+   ((AS_UINT(oz) & 0x7f800000u) != 0x7f800000u) & ((AS_UINT(dx) & 0x7f800000u) != 0x7f800000u) &           \
+   ((AS_UINT(dy) & 0x7f800000u) != 0x7f800000u) & ((AS_UINT(dz) & 0x7f800000u) != 0x7f800000u) &           \
+   (((AS_UINT(dx) | AS_UINT(dy) | AS_UINT(dz)) & 0x7fffffffu) != 0u) &                                      \
+   ((AS_UINT(tmin) & 0x7fffffffu) <= 0x7f800000u) & ((AS_UINT(tmax) & 0x7fffffffu) <= 0x7f800000u) &        \
+   ((tmin) <= (tmax)))
+
 inline int rtcl_ray_valid(float ox, float oy, float oz, float dx, float dy, float dz, float tmin, float tmax) {
-  int finite = rtcl_is_finite(ox) & rtcl_is_finite(oy) & rtcl_is_finite(oz) & rtcl_is_finite(dx) &
-               rtcl_is_finite(dy) & rtcl_is_finite(dz);
-  int nonzero = ((as_uint(dx) | as_uint(dy) | as_uint(dz)) & 0x7fffffffu) != 0u;
-  return finite & nonzero & !rtcl_is_nan(tmin) & !rtcl_is_nan(tmax) & (tmin <= tmax);
+  return RTCL_RAY_VALID(as_uint, ox, oy, oz, dx, dy, dz, tmin, tmax);
+}
+
+/* The same for eight rays in lanes: -1 in the valid lanes. */
+inline int8 rtcl_ray_valid8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, float8 tmin,
+                            float8 tmax) {
+  return RTCL_RAY_VALID(as_uint8, ox, oy, oz, dx, dy, dz, tmin, tmax);
 }
 
 /* How trace_ray_setup is compiled: a plain inline function, which PoCL
