@@ -119,7 +119,7 @@ typedef struct PacketHits {
 
 /* No hit yet: t_best just above each ray's tmax, so that a hit at tmax counts. */
 inline void packet_hits_init(PacketHits* h, float8 tmax) {
-  h->t_best = nextafter(tmax, (float8)(INFINITY));
+  h->t_best = rtcl_next_up8(tmax);
   h->det = (float8)(1.0f);
   h->V = h->W = (float8)(0.0f);
   h->prim = (int8)(-1);
