@@ -35,7 +35,7 @@ inline float8 rtcl_pick_axis(float8 x, float8 y, float8 z, int8 k1, int8 k2) {
 
 /* Eight Ray records as eight rows of eight floats, transposed into the
  * fields' lanes: out[f] lane l = field f of ray l. */
-inline void rtcl_transpose8(const float8 r[8], float8 out[8]) {
+RTCL_LANES_INLINE void rtcl_transpose8(const float8 r[8], float8 out[8]) {
   const uint8 lo = (uint8)(0, 8, 1, 9, 4, 12, 5, 13), hi = (uint8)(2, 10, 3, 11, 6, 14, 7, 15);
   const uint8 lo2 = (uint8)(0, 1, 8, 9, 4, 5, 12, 13), hi2 = (uint8)(2, 3, 10, 11, 6, 7, 14, 15);
   const uint8 lo4 = (uint8)(0, 1, 2, 3, 8, 9, 10, 11), hi4 = (uint8)(4, 5, 6, 7, 12, 13, 14, 15);
