@@ -158,15 +158,14 @@ TEST(BvhPacket, MatchesReferenceOnIncoherentRaysWithSpheres) {
 // traversal (one box test per node for the whole packet): loose frusta
 // (origins spread over the scene), tight ones, rays aimed exactly at mesh
 // vertices (which lie on leaf box faces), triangles beside spheres, an
-// invalid ray in an otherwise frustum-shaped packet; answers as the
-// single-ray kernel's and the double-precision reference's.
+// invalid ray in an otherwise frustum-shaped packet, axis-parallel rays;
+// at every precision level, answers as the single-ray kernel's and (robust,
+// exact) the double-precision reference's.
 TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
   Geometry g = random_soup(1500, 91);
   std::mt19937 rng(92);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   for (int i = 0; i < 100; ++i) g.spheres.push_back({{unit(rng), unit(rng), unit(rng)}, 0.005f + 0.03f * unit(rng)});
-  auto packet = make_accel(test_device(), "bvh-packet", g);
-  auto single = make_accel(test_device(), "bvh", g);
   std::vector<Ray> rays;
   for (int p = 0; p < 240; ++p) {
     glm::vec3 sign(unit(rng) < 0.5f ? -1.0f : 1.0f, unit(rng) < 0.5f ? -1.0f : 1.0f, unit(rng) < 0.5f ? -1.0f : 1.0f);
@@ -186,13 +185,35 @@ TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
     }
   }
   rays[8 * 5 + 3].dx = kNaN;  // inactive lane in a frustum packet
-  rays.resize(rays.size() - 3);  // a partial last packet
-  for (Query q : {Query::closest, Query::any}) {
-    std::size_t failures = 0;
-    auto report = judge_all(g, rays, run_query(*packet, rays, q), q, &failures);
-    EXPECT_EQ(failures, 0u) << (q == Query::closest ? "closest: " : "any: ") << (report.empty() ? "" : report[0]);
+  for (int l = 0; l < 8; ++l) {  // axis-parallel rays (infinite reciprocals): not a frustum
+    float y = 0.1f + 0.1f * static_cast<float>(l);
+    rays.push_back({-1.0f, y, 0.5f, 1.0f, 0.0f, 0.0f, 0.0f, kInf});
   }
-  expect_same_as_single_ray(*single, *packet, rays, "one-octant packets");
+  rays.resize(rays.size() - 3);  // a partial last packet
+  for (Precision level : {Precision::fast, Precision::robust, Precision::exact}) {
+    SCOPED_TRACE(std::string(precision_name(level)));
+    auto packet = make_accel(test_device(), "bvh-packet", g, {level});
+    auto single = make_accel(test_device(), "bvh", g, {level});
+    if (level == Precision::fast) {
+      // not watertight: the same answers as the single-ray kernel, t to rounding
+      for (Query q : {Query::closest, Query::any}) {
+        auto expected = run_query(*single, rays, q);
+        auto got = run_query(*packet, rays, q);
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+          ASSERT_EQ(got[i].prim >= 0, expected[i].prim >= 0) << "ray " << i;
+          if (q == Query::closest && got[i].prim >= 0)
+            EXPECT_NEAR(got[i].t, expected[i].t, 1e-5f * expected[i].t) << "ray " << i;
+        }
+      }
+      continue;
+    }
+    for (Query q : {Query::closest, Query::any}) {
+      std::size_t failures = 0;
+      auto report = judge_all(g, rays, run_query(*packet, rays, q), q, &failures);
+      EXPECT_EQ(failures, 0u) << (q == Query::closest ? "closest: " : "any: ") << (report.empty() ? "" : report[0]);
+    }
+    expect_same_as_single_ray(*single, *packet, rays, "one-octant packets");
+  }
 }
 
 // Invalid rays share packets with valid ones; counts 1 .. 17 leave partial

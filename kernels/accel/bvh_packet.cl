@@ -33,7 +33,9 @@
 /* Child c's box against the packet over [tmin, t_best]: rtcl_slabs8, the
  * arithmetic of intersect_boxes8, per lane (entry plane chosen by the
  * lane's direction sign).
- * Returns the entry distances, NaN where the ray misses the box. */
+ * Returns the entry distances, NaN where the ray misses the box (tested by
+ * bits, rtcl_not_nan8: -cl-fast-relaxed-math at the fast level lets the
+ * compiler fold tn == tn to true). */
 inline float8 packet_box(global const Bvh8Node* node, int c, const TracePacket* p, float8 t_best, int8 mask) {
   float lx = node->bounds[0][c], ly = node->bounds[1][c], lz = node->bounds[2][c];
   float ux = node->bounds[3][c], uy = node->bounds[4][c], uz = node->bounds[5][c];
@@ -92,7 +94,7 @@ inline float packet_max(float8 v, int8 lanes) {
  * octant and have finite reciprocals, else returns 0. */
 inline int packet_frustum(const TracePacket* p, PacketFrustum* f) {
   int8 a = p->active;
-  int8 finite = (fabs(p->ix) < INFINITY) & (fabs(p->iy) < INFINITY) & (fabs(p->iz) < INFINITY);
+  int8 finite = rtcl_is_finite8(p->ix) & rtcl_is_finite8(p->iy) & rtcl_is_finite8(p->iz);
   if (rtcl_any8(a & ~finite)) return 0;
   int pos_x = rtcl_any8(a & p->pos_x), pos_y = rtcl_any8(a & p->pos_y), pos_z = rtcl_any8(a & p->pos_z);
   if ((pos_x && rtcl_any8(a & ~p->pos_x)) || (pos_y && rtcl_any8(a & ~p->pos_y)) ||
@@ -203,7 +205,7 @@ __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const 
     } else {
       /* the rays that enter the leaf's own box, as the per-ray traversal has them */
       float8 tn = packet_box(nodes + (slot >> 3), slot & 7, p, h->t_best, alive);
-      int8 mask = tn == tn;
+      int8 mask = rtcl_not_nan8(tn);
       if (rtcl_any8(mask)) {
         packet_leaf(~ref, p, f, h, triangles, spheres, &alive, &mask);
         if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
@@ -245,7 +247,7 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
         int child = node->child[c];
         if (child == RTCL_CHILD_EMPTY) continue;
         float8 tn = packet_box(node, c, p, h->t_best, mask);
-        int8 in = tn == tn;
+        int8 in = rtcl_not_nan8(tn);
         if (!rtcl_any8(in)) continue;
         float key = rtcl_min8(select((float8)(INFINITY), tn, in));
         /* insertion into [base, sp) kept sorted by decreasing key */

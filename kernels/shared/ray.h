@@ -52,6 +52,9 @@ typedef struct TraceRay {
  * assume isnan / isinf are false). */
 inline int rtcl_is_finite(float x) { return (as_uint(x) & 0x7f800000u) != 0x7f800000u; }
 inline int rtcl_is_nan(float x) { return (as_uint(x) & 0x7fffffffu) > 0x7f800000u; }
+/* Lane-wise, -1 where x is not NaN / where x is finite. */
+inline int8 rtcl_not_nan8(float8 x) { return (as_uint8(x) & 0x7fffffffu) <= 0x7f800000u; }
+inline int8 rtcl_is_finite8(float8 x) { return (as_uint8(x) & 0x7f800000u) != 0x7f800000u; }
 
 /* The invalid-ray rule (README, "Invalid rays"): NaN or ±inf in any origin
  * or direction component, a zero direction, a NaN tmin or tmax, or
