@@ -249,29 +249,33 @@ inline int8 packet_sphere(global const SphereBlock* block, int k, const TracePac
 #endif
 
 /* Writes the packet's hits for its rays first .. first+7 below ray_count:
- * (u, v) from the winning edge functions, t = INFINITY on a miss. */
-inline void packet_store(const PacketHits* hp, global Hit* hits, uint first, uint ray_count) {
-  PacketHits h = *hp;
-  float inv_det[8], V[8], W[8], t[8];
-  int prim[8];
-  vstore8(h.t_best, 0, t);
-  vstore8(h.det, 0, inv_det);
-  vstore8(h.V, 0, V);
-  vstore8(h.W, 0, W);
-  vstore8(h.prim, 0, prim);
-  for (uint l = 0; l < 8u && first + l < ray_count; ++l) {
-    Hit out;
-    float id = 1.0f / inv_det[l];
+ * (u, v) from the winning edge functions, t = INFINITY on a miss; a full
+ * packet as four float8 stores of the transposed records. */
+inline void packet_store(const PacketHits* h, global Hit* hits, uint first, uint ray_count) {
+  float8 id = 1.0f / h->det;
+  float8 u = h->V * id, v = h->W * id;
 #ifdef RTCL_PRECISION_EXACT
-    out.t = prim[l] < 0 ? INFINITY : convert_float_rte(h.t_exact[l]);
+  float exact[8];
+  for (int l = 0; l < 8; ++l) exact[l] = convert_float_rte(h->t_exact[l]);
+  float8 t = vload8(0, exact);
 #else
-    out.t = prim[l] < 0 ? INFINITY : t[l];
+  float8 t = h->t_best;
 #endif
-    out.u = V[l] * id;
-    out.v = W[l] * id;
-    out.prim = prim[l];
-    hits[first + l] = out;
+  t = select(t, (float8)(INFINITY), h->prim < 0);
+  float8 prim = as_float8(h->prim);
+  /* Hit records (t, u, v, prim) of rays 0-1, 2-3, 4-5, 6-7 as float8 rows */
+  const uint8 lo = (uint8)(0, 8, 1, 9, 2, 10, 3, 11), hi = (uint8)(4, 12, 5, 13, 6, 14, 7, 15);
+  const uint8 lo2 = (uint8)(0, 1, 8, 9, 2, 3, 10, 11), hi2 = (uint8)(4, 5, 12, 13, 6, 7, 14, 15);
+  float8 tu_lo = shuffle2(t, u, lo), vp_lo = shuffle2(v, prim, lo);
+  float8 tu_hi = shuffle2(t, u, hi), vp_hi = shuffle2(v, prim, hi);
+  float8 rows[4] = {shuffle2(tu_lo, vp_lo, lo2), shuffle2(tu_lo, vp_lo, hi2), shuffle2(tu_hi, vp_hi, lo2),
+                    shuffle2(tu_hi, vp_hi, hi2)};
+  global float* out = (global float*)(hits + first);
+  if (first + 8u <= ray_count) {
+    for (int k = 0; k < 4; ++k) vstore8(rows[k], k, out);
+    return;
   }
+  for (uint l = 0; l < 8u && first + l < ray_count; ++l) vstore4(l & 1 ? rows[l / 2].hi : rows[l / 2].lo, l, out);
 }
 
 /* The packet trace kernel of structure NAME: rays 8p .. 8p + 7 (those below
