@@ -2,12 +2,18 @@
  * same BVH8 as accel/bvh.cl (same build, same node and block layout), but the
  * float8 lanes hold the eight rays instead of a node's eight children
  * (packet traversal, Wald, Slusallek, Benthin, Wagner 2001, "Interactive
- * rendering with coherent ray tracing"). Per node, each child box is tested
- * against the packet's rays at once; per leaf, each primitive is tested
- * against them at once. The packet shares one stack; each entry carries the
- * per-ray entry distances of its box, NaN for the rays that missed it, so
- * that a popped entry is active exactly for the rays that entered its box
- * before their current closest hit.
+ * rendering with coherent ray tracing"), in one of two ways:
+ *  - as one frustum (bvh_frustum_traverse) when the packet's valid rays
+ *    share a direction octant and have finite reciprocals: a node's eight
+ *    child boxes in one float8 test against bounds of all eight rays, as a
+ *    single ray's; at a leaf the rays that enter its box test the triangles
+ *    whose boxes the frustum meets;
+ *  - ray by ray in the lanes otherwise: per node, each child box is tested
+ *    against the packet's rays at once; per leaf, each primitive is tested
+ *    against them at once. The packet shares one stack; each entry carries
+ *    the per-ray entry distances of its box, NaN for the rays that missed
+ *    it, so that a popped entry is active exactly for the rays that entered
+ *    its box before their current closest hit.
  *
  * Contract: rays 8p .. 8p+7 (those below ray_count) form packet p; any rays
  * work (coherent ones, e.g. screen tiles or Morton order, are faster). Every
@@ -19,7 +25,8 @@
  * level the smaller id wins there too). Any hit reports some hit.
  *
  * Stack bound: as in accel/bvh.cl (a node pushes at most its children and
- * pops one), so the host's RTCL_STACK_SIZE is valid here too. */
+ * pops one), so the host's RTCL_STACK_SIZE is valid here too, for both ways.
+ * Measured: README "Packet kernel levers". */
 /* The frustum traversal's stack holds child slots (8 * node + lane), so
  * that a leaf's rays can be tested against its own box. */
 #define RTCL_BVH8_ENTRY(k) (8 * ref + (k))
