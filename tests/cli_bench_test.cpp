@@ -65,6 +65,9 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
     EXPECT_EQ(cell["embree"]["api"], api);
     EXPECT_GT(cell["embree"]["ratio"].get<double>(), 0.0) << cell.dump();
     EXPECT_GT(cell["embree"]["mrays_per_s"]["median"].get<double>(), 0.0);
+    // Embree traced the cell's rays after each of its launches
+    EXPECT_TRUE(cell["embree"]["paired"].get<bool>());
+    EXPECT_EQ(cell["embree"]["trace_ms_runs"].size(), 2u);
 #else
     EXPECT_TRUE(cell["embree"].is_null());
 #endif

@@ -156,7 +156,8 @@ std::size_t disagreeing(const std::vector<Hit>& hits, const SceneRays& rays, int
 // One cell: a warm-up launch, then `repeat` launches, each uploading the
 // rays, tracing and reading the hits back (wall) with the kernel's own time
 // from its profiling event.
-void measure(const Accel& accel, const SceneRays& rays, int kind, int repeat, BenchCell& cell) {
+void measure(const Accel& accel, const SceneRays& rays, int kind, int repeat, const EmbreeBaseline* embree,
+             BenchCell& cell) {
   const std::vector<Ray>& set = rays.sets[kind];
   cell.ray_count = set.size();
   if (set.empty()) return;
@@ -184,6 +185,7 @@ void measure(const Accel& accel, const SceneRays& rays, int kind, int repeat, Be
         kernel = static_cast<double>(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
                                      done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6;
       cell.kernel_ms.push_back(kernel);
+      if (embree) cell.embree_paired_ms.push_back(embree->trace_ms(query, cell.packets, set));
     }
   });
   cell.checked = rays.checked[kind].size();
@@ -268,7 +270,8 @@ PreparedScene prepare_bench_scene(const Device& device, const BenchSceneSpec& sp
 }
 
 std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_index, const PreparedScene& scene,
-                                       const std::string& accel_name, const BenchMatrix& matrix, int repeat) {
+                                       const std::string& accel_name, const BenchMatrix& matrix, int repeat,
+                                       const EmbreeBaseline* embree) {
   Clock::time_point start = Clock::now();
   AccelConfig config;
   config.precision = matrix.precision;
@@ -289,7 +292,8 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
     cell.device_bytes = stats.device_bytes;
     cell.primitives = stats.primitive_count;
     cell.packets = accel->rays_per_work_item(Coherence::incoherent) > 1;
-    measure(*accel, *scene.rays, k, repeat, cell);
+    measure(*accel, *scene.rays, k, repeat, embree && (!cell.packets || embree->has_packets()) ? embree : nullptr,
+            cell);
     cells.push_back(std::move(cell));
   }
   return cells;
@@ -303,10 +307,9 @@ void write_bench_results(const BenchRun& run, const BenchMatrix& matrix) {
   std::printf("\nwritten: %s, %s\n", matrix.json_path.c_str(), matrix.md_path.c_str());
 }
 
-std::vector<BenchBaseline> bench_embree(const PreparedScene& scene, const std::vector<int>& kinds, int repeat,
-                                        unsigned threads, bool robust) {
+std::vector<BenchBaseline> bench_embree(const EmbreeBaseline& embree, const PreparedScene& scene,
+                                        const std::vector<int>& kinds, int repeat) {
   std::vector<BenchBaseline> out;
-  EmbreeBaseline embree(scene.scene.geometry, threads, robust);
   const SceneRays& rays = *scene.rays;
   for (int k : kinds)
     for (bool packets : {false, true}) {
@@ -355,17 +358,19 @@ void run_bench(const BenchOptions& options) {
     progress(done, total, scene_spec.text + ": loading, rays and brute-force references");
     PreparedScene scene = prepare_bench_scene(devices.front(), scene_spec, options);
     run.scene_info.push_back(scene.info);
+    std::unique_ptr<EmbreeBaseline> embree;
     if (!run.embree_version.empty()) {
       progress(done, total, scene_spec.text + " / Embree " + run.embree_version);
-      for (BenchBaseline& b :
-           bench_embree(scene, matrix.kinds, options.repeat, options.embree_threads, options.embree_robust))
+      embree = std::make_unique<EmbreeBaseline>(scene.scene.geometry, options.embree_threads, options.embree_robust);
+      for (BenchBaseline& b : bench_embree(*embree, scene, matrix.kinds, options.repeat))
         run.embree.push_back(std::move(b));
       ++done;
     }
     for (std::size_t d = 0; d < devices.size(); ++d)
       for (const std::string& accel_name : matrix.accels) {
         progress(done, total, scene_spec.text + " / " + accel_name + " / " + run.devices[d].name);
-        for (BenchCell& cell : bench_structure(devices[d], d, scene, accel_name, matrix, options.repeat))
+        for (BenchCell& cell :
+             bench_structure(devices[d], d, scene, accel_name, matrix, options.repeat, embree.get()))
           run.cells.push_back(std::move(cell));
         ++done;
       }

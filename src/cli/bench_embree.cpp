@@ -57,6 +57,15 @@ std::vector<Hit> EmbreeBaseline::measure(Query query, bool packets, const std::v
   return hits;
 }
 
+double EmbreeBaseline::trace_ms(Query query, bool packets, const std::vector<Ray>& rays) const {
+  const bench::EmbreeScene& embree = impl_->scene;
+  if (rays.empty()) return 0.0;
+  embree.prepare(query, rays.data(), rays.size(), packets ? bench::EmbreeApi::packet8 : bench::EmbreeApi::single);
+  Clock::time_point start = Clock::now();
+  embree.trace_prepared(threads_);
+  return ms_between(start, Clock::now());
+}
+
 #else
 
 struct EmbreeBaseline::Impl {};
@@ -72,6 +81,8 @@ bool EmbreeBaseline::has_packets() const { return false; }
 std::vector<Hit> EmbreeBaseline::measure(Query, bool, const std::vector<Ray>&, int, BenchBaseline&) const {
   return {};
 }
+
+double EmbreeBaseline::trace_ms(Query, bool, const std::vector<Ray>&) const { return 0.0; }
 
 #endif
 

@@ -40,6 +40,12 @@ class EmbreeBaseline {
   std::vector<Hit> measure(Query query, bool packets, const std::vector<Ray>& rays, int repeat,
                            BenchBaseline& out) const;
 
+  // One trace of `rays` (prepared before the clock starts): the traversal's
+  // ms, as measure() times each of its traces. `rtcl bench` runs one after
+  // each of a cell's launches, so that the cell's ratio compares times
+  // taken in the same moments.
+  double trace_ms(Query query, bool packets, const std::vector<Ray>& rays) const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_embree.hpp"
 #include "bench_report.hpp"
 #include "bench_scenes.hpp"
 #include "rtcl/accel/precision.hpp"
@@ -59,14 +60,17 @@ PreparedScene prepare_bench_scene(const Device& device, const BenchSceneSpec& sp
 
 // One structure over one scene on one device at the matrix's precision
 // level: a cell per ray kind, with `device_index` as the cell's device.
+// With `embree` (the scene's baseline, else null), each timed launch is
+// followed by Embree's trace of the same rays (BenchCell::embree_paired_ms).
 std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_index, const PreparedScene& scene,
-                                       const std::string& accel, const BenchMatrix& matrix, int repeat);
+                                       const std::string& accel, const BenchMatrix& matrix, int repeat,
+                                       const EmbreeBaseline* embree = nullptr);
 
 // Embree's figures on the scene's ray sets (single rays, and 8-ray packets
 // where Embree traces them natively), checked like the cells; needs rtcl
 // built with Embree (embree_baseline_version() not empty).
-std::vector<BenchBaseline> bench_embree(const PreparedScene& scene, const std::vector<int>& kinds, int repeat,
-                                        unsigned threads, bool robust);
+std::vector<BenchBaseline> bench_embree(const EmbreeBaseline& embree, const PreparedScene& scene,
+                                        const std::vector<int>& kinds, int repeat);
 
 // bench.json and bench.md, each written whole or not at all; the table on
 // stdout.

@@ -28,14 +28,23 @@ Spread rate_of(std::size_t rays, const Spread& ms) {
   return {rate(ms.max), rate(ms.median), rate(ms.min)};
 }
 
+// Embree's traversal rate for a cell: from the traces paired with its
+// launches when it has them, else from the baseline's own traces.
+Spread embree_rate(const BenchCell& c, const BenchBaseline& b) {
+  return c.embree_paired_ms.empty() ? rate_of(b.ray_count, spread_of(b.trace_ms))
+                                    : rate_of(c.ray_count, spread_of(c.embree_paired_ms));
+}
+
 // The cell against its Embree baseline: Embree's traversal rate and the
 // ratio of the medians (rtcl kernel rate / Embree traversal rate).
 json embree_json(const BenchCell& c, const BenchBaseline* b) {
   if (!b) return nullptr;
-  Spread embree = rate_of(b->ray_count, spread_of(b->trace_ms));
+  Spread embree = embree_rate(c, *b);
   Spread rtcl = rate_of(c.ray_count, spread_of(c.kernel_ms));
   return {{"api", b->api},
           {"threads", b->threads},
+          {"paired", !c.embree_paired_ms.empty()},
+          {"trace_ms_runs", c.embree_paired_ms.empty() ? b->trace_ms : c.embree_paired_ms},
           {"mrays_per_s", spread_json(embree)},
           {"ratio", embree.median > 0.0 ? rtcl.median / embree.median : 0.0}};
 }
@@ -185,7 +194,7 @@ std::string bench_markdown(const BenchRun& run) {
           Spread rate = rate_of(c->ray_count, spread_of(c->kernel_ms));
           row += format(" %.2f (%.2f - %.2f)", rate.median, rate.min, rate.max);
           if (const BenchBaseline* b = baseline_for(run, *c)) {
-            Spread embree = rate_of(b->ray_count, spread_of(b->trace_ms));
+            Spread embree = embree_rate(*c, *b);
             if (embree.median > 0.0) row += format(" x%.2fE", rate.median / embree.median);
           }
           row += " |";

@@ -36,6 +36,10 @@ struct BenchCell {
   // Whether the structure traces packets of eight consecutive rays (its
   // compared with Embree's packet API, else with its single-ray API).
   bool packets = false;
+  // Embree's traversal of the same rays right after each timed launch (its
+  // API as `packets` says), when the run has the baseline and Embree traces
+  // such packets: the cell's ratio is taken from these.
+  std::vector<double> embree_paired_ms;
 };
 
 // Embree's figures for one scene and ray set (bench_embree.hpp).
