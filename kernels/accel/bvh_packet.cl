@@ -81,21 +81,9 @@ typedef struct PacketFrustum {
   int near_x, near_y, near_z, far_x, far_y, far_z; /* bounds rows, as in TraceRay */
 } PacketFrustum;
 
-/* Min / max of v over `lanes` (+inf / -inf for none), by compares: the
- * values here are never NaN, and fmin / fmax's NaN rules cost a compare
- * and a blend more per step. */
-inline float packet_min(float8 v, int8 lanes) {
-  v = select((float8)(INFINITY), v, lanes);
-  float4 m4 = select(v.hi, v.lo, v.lo < v.hi);
-  float2 m2 = select(m4.hi, m4.lo, m4.lo < m4.hi);
-  return m2.x < m2.y ? m2.x : m2.y;
-}
-inline float packet_max(float8 v, int8 lanes) {
-  v = select((float8)(-INFINITY), v, lanes);
-  float4 m4 = select(v.hi, v.lo, v.lo > v.hi);
-  float2 m2 = select(m4.hi, m4.lo, m4.lo > m4.hi);
-  return m2.x > m2.y ? m2.x : m2.y;
-}
+/* Min / max of v over `lanes` (+inf / -inf for none); never NaN here. */
+inline float packet_min(float8 v, int8 lanes) { return rtcl_min8_ordered(select((float8)(INFINITY), v, lanes)); }
+inline float packet_max(float8 v, int8 lanes) { return rtcl_max8_ordered(select((float8)(-INFINITY), v, lanes)); }
 
 /* Fills *f and returns 1 when the packet's active rays share a direction
  * octant and have finite reciprocals, else returns 0. */
@@ -148,10 +136,7 @@ inline int frustum_triangles(global const TriangleBlock* block, const PacketFrus
                       f->near_x == 0 ? hi[0] : lo[0], f->near_y == 1 ? hi[1] : lo[1], f->near_z == 2 ? hi[2] : lo[2],
                       f->onx, f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->lx, f->ly, f->lz, f->hx, f->hy, f->hz,
                       f->tmin, tmax, &tn, &tf);
-  int8 bits = ((tn <= tf) & (vload8(0, block->prim) >= 0)) & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
-  int4 o4 = bits.lo | bits.hi;
-  int2 o2 = o4.lo | o4.hi;
-  return o2.lo | o2.hi;
+  return rtcl_lane_bits8((tn <= tf) & (vload8(0, block->prim) >= 0));
 }
 
 /* The leaf `leaf` (a node reference's complement) against the packet's

@@ -59,24 +59,22 @@ inline int8 rtcl_is_finite8(float8 x) { return (as_uint8(x) & 0x7f800000u) != 0x
 /* The invalid-ray rule (README, "Invalid rays"): NaN or ±inf in any origin
  * or direction component, a zero direction, a NaN tmin or tmax, or
  * tmin > tmax: the ray reports a miss. */
-/* The rule as one expression over scalars (AS_UINT = as_uint: 1 where
- * valid) or vectors (as_uint8: -1 in the valid lanes). */
-#define RTCL_RAY_VALID(AS_UINT, ox, oy, oz, dx, dy, dz, tmin, tmax)                                          \
-  (((AS_UINT(ox) & 0x7f800000u) != 0x7f800000u) & ((AS_UINT(oy) & 0x7f800000u) != 0x7f800000u) &           \
-   ((AS_UINT(oz) & 0x7f800000u) != 0x7f800000u) & ((AS_UINT(dx) & 0x7f800000u) != 0x7f800000u) &           \
-   ((AS_UINT(dy) & 0x7f800000u) != 0x7f800000u) & ((AS_UINT(dz) & 0x7f800000u) != 0x7f800000u) &           \
-   (((AS_UINT(dx) | AS_UINT(dy) | AS_UINT(dz)) & 0x7fffffffu) != 0u) &                                      \
-   ((AS_UINT(tmin) & 0x7fffffffu) <= 0x7f800000u) & ((AS_UINT(tmax) & 0x7fffffffu) <= 0x7f800000u) &        \
+/* The rule as one expression over scalars or vectors, from the bit tests
+ * above: FINITE / NOT_NAN the scalar or lane-wise ones, AS_UINT as_uint or
+ * as_uint8 (scalars give 1 where valid, vectors -1 in the valid lanes). */
+#define RTCL_RAY_VALID(FINITE, NOT_NAN, AS_UINT, ox, oy, oz, dx, dy, dz, tmin, tmax)                   \
+  (FINITE(ox) & FINITE(oy) & FINITE(oz) & FINITE(dx) & FINITE(dy) & FINITE(dz) &                      \
+   (((AS_UINT(dx) | AS_UINT(dy) | AS_UINT(dz)) & 0x7fffffffu) != 0u) & NOT_NAN(tmin) & NOT_NAN(tmax) & \
    ((tmin) <= (tmax)))
 
 inline int rtcl_ray_valid(float ox, float oy, float oz, float dx, float dy, float dz, float tmin, float tmax) {
-  return RTCL_RAY_VALID(as_uint, ox, oy, oz, dx, dy, dz, tmin, tmax);
+  return RTCL_RAY_VALID(rtcl_is_finite, !rtcl_is_nan, as_uint, ox, oy, oz, dx, dy, dz, tmin, tmax);
 }
 
 /* The same for eight rays in lanes: -1 in the valid lanes. */
 inline int8 rtcl_ray_valid8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, float8 tmin,
                             float8 tmax) {
-  return RTCL_RAY_VALID(as_uint8, ox, oy, oz, dx, dy, dz, tmin, tmax);
+  return RTCL_RAY_VALID(rtcl_is_finite8, rtcl_not_nan8, as_uint8, ox, oy, oz, dx, dy, dz, tmin, tmax);
 }
 
 /* How trace_ray_setup is compiled: a plain inline function, which PoCL
@@ -199,6 +197,28 @@ inline int rtcl_any8(int8 m) {
   return (o2.lo | o2.hi) != 0u;
 }
 
+/* Min / max over the lanes by compares, for lanes that are never NaN:
+ * fmin / fmax's NaN rules cost a compare and a blend more per step. */
+inline float rtcl_min8_ordered(float8 a) {
+  float4 m4 = select(a.hi, a.lo, a.lo < a.hi);
+  float2 m2 = select(m4.hi, m4.lo, m4.lo < m4.hi);
+  return m2.x < m2.y ? m2.x : m2.y;
+}
+
+inline float rtcl_max8_ordered(float8 a) {
+  float4 m4 = select(a.hi, a.lo, a.lo > a.hi);
+  float2 m2 = select(m4.hi, m4.lo, m4.lo > m4.hi);
+  return m2.x > m2.y ? m2.x : m2.y;
+}
+
+/* The lanes of a comparison result (lanes 0 or -1) as bits 0..7. */
+inline int rtcl_lane_bits8(int8 m) {
+  int8 bits = m & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
+  int4 o4 = bits.lo | bits.hi;
+  int2 o2 = o4.lo | o4.hi;
+  return o2.lo | o2.hi;
+}
+
 inline float rtcl_min8(float8 a) {
   float4 m4 = fmin(a.lo, a.hi);
   float2 m2 = fmin(m4.lo, m4.hi);
@@ -217,10 +237,7 @@ inline float rtcl_max8(float8 a) {
  * per lane (measured: 1.00-1.27x the BVH's kernel time, medians on the
  * twelve bench/ sets, README "Kernel levers on the single-ray BVH"). */
 inline int rtcl_lane_of(float8 a, float m) {
-  int8 bits = (a == (float8)(m)) & (int8)(1, 2, 4, 8, 16, 32, 64, 128);
-  int4 o4 = bits.lo | bits.hi;
-  int2 o2 = o4.lo | o4.hi;
-  int mask = o2.lo | o2.hi;
+  int mask = rtcl_lane_bits8(a == (float8)(m));
   return mask ? 31 - (int)clz(mask & -mask) : 0;
 }
 

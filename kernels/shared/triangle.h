@@ -173,9 +173,7 @@ RTCL_TRIANGLE_LANES_INLINE int intersect_triangle_lanes(float8 ax, float8 ay, fl
   int8 ok = rtcl_watertight_hit8(&w, (float8)(s->sz), (float8)(s->tmin), (float8)(h->t_best), &t, &det);
   if (!rtcl_any8(ok)) return 0;
   float8 t_ok = select((float8)(INFINITY), t, ok);
-  float4 m4 = select(t_ok.hi, t_ok.lo, t_ok.lo < t_ok.hi);
-  float2 m2 = select(m4.hi, m4.lo, m4.lo < m4.hi);
-  float m = m2.x < m2.y ? m2.x : m2.y;
+  float m = rtcl_min8_ordered(t_ok);
   int lane = rtcl_lane_of(t_ok, m);
   float inv_det = 1.0f / rtcl_lane(det, lane);
   h->t_best = m;
