@@ -1,11 +1,18 @@
 // Helpers of the A/B programs in bench/ (kernel_ab, ray_sort, build_ab):
-// event times, order statistics of repeated runs, comma lists.
+// event times, order statistics of repeated runs, comma lists, the ROUNDS
+// argument, the scenes directory and a bench/ scene's geometry.
 #pragma once
 
+#include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/cl/opencl.hpp"
+#include "rtcl/error.hpp"
+#include "rtcl/scene/geometry.hpp"
+#include "rtcl/scene/mesh_io.hpp"
+#include "rtcl/scene/procedural.hpp"
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <sstream>
 #include <string>
@@ -38,6 +45,26 @@ inline std::vector<std::string> split(const std::string& list) {
   for (std::string item; std::getline(in, item, ',');)
     if (!item.empty()) out.push_back(item);
   return out;
+}
+
+// The ROUNDS argument: a positive count, else an Error naming it.
+inline int parse_rounds(const char* text) {
+  const int rounds = std::atoi(text);
+  if (rounds < 1) throw Error(std::string("ROUNDS must be a positive number, not '") + text + "'");
+  return rounds;
+}
+
+// $RTCL_SCENES_DIR, else `fallback` (the build's ../shared/scenes).
+inline std::string scenes_dir_or(const char* fallback) {
+  const char* dir = std::getenv("RTCL_SCENES_DIR");
+  return dir && *dir ? dir : fallback;
+}
+
+// A bench/ scene's geometry: its mesh, inside its stadium where it has one.
+inline Geometry spec_geometry(const SceneSpec& spec, const std::string& scenes_dir) {
+  Geometry geometry = load_mesh(scenes_dir + "/" + spec.file).geometry;
+  if (spec.stadium > 0.0f) add_stadium(geometry, spec.stadium);
+  return geometry;
 }
 
 // main() of an A/B program: run(argc, argv)'s status, or one line naming

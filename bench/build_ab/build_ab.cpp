@@ -29,7 +29,6 @@
 #include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/geometry.hpp"
-#include "rtcl/scene/mesh_io.hpp"
 #include "rtcl/scene/procedural.hpp"
 
 #include "../ab_support.hpp"
@@ -48,9 +47,7 @@ Geometry load_scene(const std::string& name, const std::string& scenes_dir) {
   }
   const SceneSpec* spec = find_scene_spec(name);
   if (!spec) throw Error("scene '" + name + "': neither a bench/ scene nor soup:N");
-  Geometry geometry = load_mesh(scenes_dir + "/" + spec->file).geometry;
-  if (spec->stadium > 0.0f) add_stadium(geometry, spec->stadium);
-  return geometry;
+  return spec_geometry(*spec, scenes_dir);
 }
 
 // ms of make_bvh's build_ms path without the upload: [0] the whole, then
@@ -86,10 +83,8 @@ int run(int argc, char** argv) {
     return 2;
   }
   const std::vector<std::string> scenes = split(argv[1]);
-  const int rounds = std::atoi(argv[2]);
-  if (rounds < 1) throw Error(std::string("ROUNDS must be a positive number, not '") + argv[2] + "'");
-  const char* dir_env = std::getenv("RTCL_SCENES_DIR");
-  const std::string scenes_dir = dir_env && *dir_env ? dir_env : RTCL_BUILD_AB_SCENES_DIR;
+  const int rounds = parse_rounds(argv[2]);
+  const std::string scenes_dir = scenes_dir_or(RTCL_BUILD_AB_SCENES_DIR);
   const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
   const BvhConfig config;  // the "bvh" structure's defaults: SAH on all hardware threads
   for (const std::string& name : scenes)

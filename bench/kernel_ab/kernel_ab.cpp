@@ -41,8 +41,6 @@
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/geometry.hpp"
-#include "rtcl/scene/mesh_io.hpp"
-#include "rtcl/scene/procedural.hpp"
 
 #include "../ab_support.hpp"
 #ifdef RTCL_HAVE_EMBREE
@@ -60,16 +58,14 @@ int run(int argc, char** argv) {
     return 2;
   }
   const std::vector<std::string> scenes = split(argv[1]);
-  const int rounds = std::atoi(argv[2]);
-  if (rounds < 1) throw Error(std::string("ROUNDS must be a positive number, not '") + argv[2] + "'");
+  const int rounds = parse_rounds(argv[2]);
   const std::vector<std::string> versions(argv + 3, argv + argc);
   const char* accel_env = std::getenv("AB_ACCEL");
   const std::string accel_name = accel_env && *accel_env ? accel_env : "bvh";
   const char* res_env = std::getenv("RTCL_BENCH_RES");
   const int res = res_env && *res_env ? std::atoi(res_env) : 512;
   if (res < 1) throw Error("RTCL_BENCH_RES must be a positive number");
-  const char* dir_env = std::getenv("RTCL_SCENES_DIR");
-  const std::string scenes_dir = dir_env && *dir_env ? dir_env : RTCL_KERNEL_AB_SCENES_DIR;
+  const std::string scenes_dir = scenes_dir_or(RTCL_KERNEL_AB_SCENES_DIR);
   const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
 #ifdef RTCL_HAVE_EMBREE
   const bool use_embree = std::getenv("AB_NO_EMBREE") == nullptr;
@@ -81,8 +77,7 @@ int run(int argc, char** argv) {
     if (!spec || spec->fit)
       throw Error("scene '" + scene_name +
                   "': not a bench/ scene with a fixed camera (bunny, dragon, sponza, sibenik, teapot-stadium)");
-    Geometry geometry = load_mesh(scenes_dir + "/" + spec->file).geometry;
-    if (spec->stadium > 0.0f) add_stadium(geometry, spec->stadium);
+    Geometry geometry = spec_geometry(*spec, scenes_dir);
     validate(geometry);
 
     std::vector<std::unique_ptr<Accel>> accels;

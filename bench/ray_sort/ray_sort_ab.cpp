@@ -40,8 +40,6 @@
 #include "rtcl/error.hpp"
 #include "rtcl/render/ray_order.hpp"
 #include "rtcl/scene/geometry.hpp"
-#include "rtcl/scene/mesh_io.hpp"
-#include "rtcl/scene/procedural.hpp"
 
 #include "../ab_support.hpp"
 
@@ -92,8 +90,7 @@ int run(int argc, char** argv) {
     return 2;
   }
   const std::vector<std::string> scenes = split(argv[1]);
-  const int rounds = std::atoi(argv[2]);
-  if (rounds < 1) throw Error(std::string("ROUNDS must be a positive number, not '") + argv[2] + "'");
+  const int rounds = parse_rounds(argv[2]);
   const std::vector<std::string> keys(argv + 3, argv + argc);
   const char* res_env = std::getenv("RTCL_BENCH_RES");
   const int res = res_env && *res_env ? std::atoi(res_env) : 1024;
@@ -102,16 +99,14 @@ int run(int argc, char** argv) {
   if (res < 1 || chunks < 1) throw Error("RTCL_BENCH_RES and SORT_CHUNKS must be positive numbers");
   std::vector<Key> parsed;
   for (const std::string& key : keys) parsed.push_back(parse_key(key));
-  const char* dir_env = std::getenv("RTCL_SCENES_DIR");
-  const std::string scenes_dir = dir_env && *dir_env ? dir_env : RTCL_RAY_SORT_AB_SCENES_DIR;
+  const std::string scenes_dir = scenes_dir_or(RTCL_RAY_SORT_AB_SCENES_DIR);
 
   Device device = Device::open();
   cl::CommandQueue& queue = device.queue();
   for (const std::string& scene_name : scenes) {
     const SceneSpec* spec = find_scene_spec(scene_name);
     if (!spec || spec->fit) throw Error("scene '" + scene_name + "': not a bench/ scene with a fixed camera");
-    Geometry geometry = load_mesh(scenes_dir + "/" + spec->file).geometry;
-    if (spec->stadium > 0.0f) add_stadium(geometry, spec->stadium);
+    Geometry geometry = spec_geometry(*spec, scenes_dir);
     validate(geometry);
     const Aabb bounds = geometry.bounds();
     std::unique_ptr<Accel> accel = make_accel(device, "bvh", geometry);
