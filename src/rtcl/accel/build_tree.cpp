@@ -8,15 +8,6 @@
 
 namespace rtcl {
 
-namespace {
-
-bool contains(const Aabb& outer, const Aabb& inner) {
-  return outer.lower.x <= inner.lower.x && outer.lower.y <= inner.lower.y && outer.lower.z <= inner.lower.z &&
-         outer.upper.x >= inner.upper.x && outer.upper.y >= inner.upper.y && outer.upper.z >= inner.upper.z;
-}
-
-}  // namespace
-
 std::uint32_t BuildTree::depth() const {
   if (nodes.empty()) return 0;
   std::uint32_t deepest = 0;
@@ -105,7 +96,7 @@ std::string check(const BuildTree& tree, std::span<const Aabb> bounds, std::span
         auto it = position.find(tree.prims[k]);
         if (it == position.end()) return where + " holds unknown id " + std::to_string(tree.prims[k]);
         if (prim_seen[it->second]++) return "id " + std::to_string(tree.prims[k]) + " is in two leaves";
-        if (!contains(node.bounds, bounds[it->second]))
+        if (!node.bounds.contains(bounds[it->second]))
           return where + " does not contain the box of id " + std::to_string(tree.prims[k]);
         ++prims_in_leaves;
       }
@@ -113,7 +104,7 @@ std::string check(const BuildTree& tree, std::span<const Aabb> bounds, std::span
     }
     for (std::uint32_t c : node.child) {
       if (c >= tree.nodes.size()) return where + " has child " + std::to_string(c) + " that does not exist";
-      if (!contains(node.bounds, tree.nodes[c].bounds))
+      if (!node.bounds.contains(tree.nodes[c].bounds))
         return where + " does not contain its child " + std::to_string(c);
       todo.push_back(c);
     }

@@ -29,15 +29,6 @@ namespace rtcl {
 
 namespace {
 
-bool contains(const Aabb& outer, const Aabb& inner) {
-  return glm::all(glm::lessThanEqual(outer.lower, inner.lower)) &&
-         glm::all(glm::greaterThanEqual(outer.upper, inner.upper));
-}
-
-bool contains(const Aabb& box, const glm::vec3& p) {
-  return glm::all(glm::lessThanEqual(box.lower, p)) && glm::all(glm::lessThanEqual(p, box.upper));
-}
-
 // One child of a wide node while it is formed: an inner binary node, or a
 // group of binary leaves that will share one block.
 struct Slot {
@@ -248,7 +239,7 @@ class Flattener {
     const BuildNode& b = tree_.nodes[n];
     for (std::uint32_t c : b.child) {
       visit(c);
-      if (!contains(b.bounds, tree_.nodes[c].bounds))
+      if (!b.bounds.contains(tree_.nodes[c].bounds))
         fail("node " + std::to_string(n) + " does not contain its child " + std::to_string(c));
       slots.push_back(slot_of(c));
     }
@@ -360,7 +351,7 @@ class Flattener {
       const glm::uvec3& t = geometry_.triangles[p];
       const glm::vec3 &a = geometry_.vertices[t.x], &b = geometry_.vertices[t.y], &c = geometry_.vertices[t.z];
       const Aabb& box = tree_.nodes[source.leaves[lane]].bounds;
-      if (!contains(box, a) || !contains(box, b) || !contains(box, c)) fail_outside(source.leaves[lane], p);
+      if (!box.contains(a) || !box.contains(b) || !box.contains(c)) fail_outside(source.leaves[lane], p);
       if (zero_area(a, b, c)) fail("zero-area triangle " + std::to_string(p) + " is in a leaf");
       mark(seen, p);
       set_lane(out, lane, p, a, b, c);
@@ -374,7 +365,7 @@ class Flattener {
       SphereBlock out = empty_sphere_block();
       for (std::uint32_t lane = 0; lane < source.count; ++lane) {
         std::uint32_t p = source.prims[lane];
-        if (!contains(tree_.nodes[source.leaves[lane]].bounds, geometry_.primitive_bounds(p)))
+        if (!tree_.nodes[source.leaves[lane]].bounds.contains(geometry_.primitive_bounds(p)))
           fail_outside(source.leaves[lane], p);
         mark(seen, p);
         set_lane(out, lane, p, geometry_.spheres[p - geometry_.triangles.size()]);

@@ -19,6 +19,13 @@ struct Aabb {
     lower = glm::min(lower, b.lower);
     upper = glm::max(upper, b.upper);
   }
+  // Closed containment: every coordinate of the point / box within this one.
+  bool contains(const glm::vec3& p) const {
+    return glm::all(glm::lessThanEqual(lower, p)) && glm::all(glm::lessThanEqual(p, upper));
+  }
+  bool contains(const Aabb& b) const {
+    return glm::all(glm::lessThanEqual(lower, b.lower)) && glm::all(glm::greaterThanEqual(upper, b.upper));
+  }
   glm::vec3 extent() const { return upper - lower; }
   glm::vec3 center() const { return 0.5f * (lower + upper); }
   // Surface area; 0 for an empty box (SAH cost unit).
