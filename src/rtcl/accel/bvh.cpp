@@ -6,10 +6,14 @@
 #include <cmath>
 
 #include "rtcl/error.hpp"
+#include "rtcl/parallel.hpp"
 
 namespace rtcl {
 
 namespace {
+
+// Primitives per host thread in the boxes pass (parallel.hpp).
+constexpr std::size_t kBoundsPartMin = 16384;
 
 // A sphere's box, widened by a few ulps of its coordinates: centre +- radius
 // rounded to float may fall just inside the true surface.
@@ -55,9 +59,12 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config) {
       std::partition_point(ids.begin(), ids.end(), [&](std::uint32_t p) { return p < geometry.triangles.size(); }) -
       ids.begin());
   std::vector<Aabb> bounds(ids.size());
-  for (std::size_t i = 0; i < ids.size(); ++i)
-    bounds[i] = i < first_sphere ? geometry.primitive_bounds(ids[i])
-                                 : sphere_bounds(geometry.spheres[ids[i] - geometry.triangles.size()]);
+  for_each_part(ids.size(), part_count(ids.size(), bvh_thread_count(config), kBoundsPartMin),
+                [&](unsigned, std::size_t begin, std::size_t end) {
+                  for (std::size_t i = begin; i < end; ++i)
+                    bounds[i] = i < first_sphere ? geometry.primitive_bounds(ids[i])
+                                                 : sphere_bounds(geometry.spheres[ids[i] - geometry.triangles.size()]);
+                });
   std::span<const Aabb> all_bounds(bounds);
   std::span<const std::uint32_t> all_ids(ids);
   return join(build_kind(all_bounds.first(first_sphere), all_ids.first(first_sphere), config),

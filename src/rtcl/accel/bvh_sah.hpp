@@ -39,11 +39,11 @@ struct SahConfig {
   // traversal stack, stays below max_sah_depth + log2(n) even for adversarial
   // inputs, at some loss of quality there. At most 1024.
   std::uint32_t max_sah_depth = 48;
-  // Subtrees with at least this many primitives may be built on another
-  // thread (one that waits for work takes the largest waiting subtree), and
-  // nodes of at least 16384 are binned by two threads when one waits;
-  // thread_count bounds the threads in use (0 = all hardware threads). The
-  // tree does not depend on the threads.
+  // With more than one thread, each subtree of at least this many
+  // primitives is a task of its own (a thread that waits for work takes the
+  // largest waiting one), and a root of at least 16384 primitives is binned
+  // by the threads together; thread_count bounds the threads in use (0 =
+  // all hardware threads). The tree does not depend on the threads.
   std::size_t parallel_min_primitives = 2048;
   unsigned thread_count = 0;
 };

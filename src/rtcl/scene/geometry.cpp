@@ -1,8 +1,10 @@
 #include "rtcl/scene/geometry.hpp"
 
 #include <cmath>
+#include <vector>
 
 #include "rtcl/error.hpp"
+#include "rtcl/parallel.hpp"
 
 namespace rtcl {
 
@@ -56,19 +58,30 @@ namespace {
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 }  // namespace
 
+// Vertices or triangles per host thread in validate (parallel.hpp).
+constexpr std::size_t kValidatePartMin = 16384;
+
 GeometryReport validate(const Geometry& g) {
   GeometryReport report;
-  for (std::size_t i = 0; i < g.vertices.size(); ++i)
-    if (!finite(g.vertices[i]))
-      throw Error(g.source + ": vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
-  for (std::size_t i = 0; i < g.triangles.size(); ++i) {
-    const glm::uvec3& t = g.triangles[i];
-    for (int k = 0; k < 3; ++k)
-      if (t[k] >= g.vertices.size())
-        throw Error(g.source + ": triangle " + std::to_string(i) + " uses vertex index " + std::to_string(t[k]) +
-                    ", but there are only " + std::to_string(g.vertices.size()) + " vertices");
-    if (zero_area(g, i)) ++report.zero_area_triangles;
-  }
+  for_each_part(g.vertices.size(), part_count(g.vertices.size(), 0, kValidatePartMin),
+                [&](unsigned, std::size_t begin, std::size_t end) {
+                  for (std::size_t i = begin; i < end; ++i)
+                    if (!finite(g.vertices[i]))
+                      throw Error(g.source + ": vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
+                });
+  const unsigned parts = part_count(g.triangles.size(), 0, kValidatePartMin);
+  std::vector<std::size_t> zero_area_counts(parts, 0);
+  for_each_part(g.triangles.size(), parts, [&](unsigned part, std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const glm::uvec3& t = g.triangles[i];
+      for (int k = 0; k < 3; ++k)
+        if (t[k] >= g.vertices.size())
+          throw Error(g.source + ": triangle " + std::to_string(i) + " uses vertex index " + std::to_string(t[k]) +
+                      ", but there are only " + std::to_string(g.vertices.size()) + " vertices");
+      if (zero_area(g, i)) ++zero_area_counts[part];
+    }
+  });
+  for (std::size_t count : zero_area_counts) report.zero_area_triangles += count;
   for (std::size_t i = 0; i < g.spheres.size(); ++i) {
     const Sphere& s = g.spheres[i];
     if (!finite(s.center) || !std::isfinite(s.radius) || !(s.radius > 0.0f))
