@@ -431,15 +431,19 @@ Geometry soup_with_spheres(std::uint32_t seed) {
   return g;
 }
 
-template <class T>
-bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+template <class T, class Allocator>
+bool same_bytes(const std::vector<T, Allocator>& a, const std::vector<T, Allocator>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 
+// Large enough (over 4096 binary nodes, both kinds) that the walk forms
+// the subtrees below its top levels in parts, one thread or several.
 TEST(Bvh, FlattenDoesNotDependOnTheThreads) {
-  Geometry g = soup_with_spheres(52);
+  Geometry g = soup_with_spheres(20000, 4000, 52);
   BuildTree tree = build_binary_bvh(g);
+  ASSERT_GE(tree.nodes.size(), 4096u);
   Bvh8 one = flatten_bvh8(tree, g, true, 1);
+  EXPECT_EQ(check_wide(one, g), "");
   for (unsigned threads : {2u, 3u}) {
     Bvh8 many = flatten_bvh8(tree, g, true, threads);
     EXPECT_TRUE(same_bytes(one.nodes, many.nodes)) << threads << " threads";

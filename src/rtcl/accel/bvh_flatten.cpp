@@ -1,12 +1,16 @@
 // flatten_bvh8 (bvh.hpp): the binary build tree collapsed into 8-wide nodes
 // and primitive blocks, in three passes.
 //
-// 1. Walk (one thread): wide nodes are formed depth first. A wide node's
-//    inner children get consecutive indices when it is formed, and the first
-//    child's subtree is formed before the second's; blocks are numbered in
-//    the order their wide nodes are formed. A block is recorded as its lanes'
+// 1. Walk: wide nodes are formed depth first. A wide node's inner children
+//    get consecutive indices when it is formed, and the first child's
+//    subtree is formed before the second's; blocks are numbered in the order
+//    their wide nodes are formed. A block is recorded as its lanes'
 //    primitive ids and binary leaves; the walk reads the tree, never the
-//    geometry.
+//    geometry. Trees of kSplitMinNodes binary nodes and more are walked in
+//    parts: the top kSplitDepth - 1 wide levels first, then each subtree
+//    below them on whichever thread is free, each part's nodes and blocks
+//    placed after the top's in the order the top met them, so that the
+//    result does not depend on the threads.
 // 2. Gather (block ranges on parallel threads): each block is filled from the
 //    geometry, every primitive's vertices read once and checked there: inside
 //    its binary leaf's box, not a zero-area triangle, not marked before by
@@ -15,6 +19,7 @@
 //    marked.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <exception>
 #include <limits>
@@ -74,6 +79,39 @@ struct BlockSource {
   std::uint32_t count;  // lanes in use
 };
 
+// What one walk forms: wide nodes (children indexed within them, blocks
+// within its sources) and the blocks' sources.
+struct WalkOutput {
+  std::vector<Bvh8Node> nodes;
+  std::vector<BlockSource> triangle_sources, sphere_sources;
+  std::uint32_t stack_size = 0, depth = 0;
+};
+
+// A wide node to form from binary node `binary` at index `wide`; stack:
+// the entries its ancestors leave on the traversal stack, worst case.
+struct Todo {
+  std::uint32_t binary, wide, stack, depth;
+};
+
+// A subtree the top walk leaves to a part: its first wide node and the
+// lane of the top node that refers to it.
+struct Deferred {
+  Todo todo;
+  std::uint32_t parent, lane;
+};
+
+// Trees walked in parts (see above), and the wide depth of the parts' roots
+// (up to 64 parts).
+constexpr std::size_t kSplitMinNodes = 4096;
+constexpr std::uint32_t kSplitDepth = 3;
+
+// Leaf reference `ref` of a part, its block moved by the offset of its kind.
+rtcl_i32 rebase_leaf(rtcl_i32 ref, std::uint32_t triangle_offset, std::uint32_t sphere_offset) {
+  const auto code = static_cast<std::uint32_t>(~ref);
+  const std::uint32_t block = (code >> 1) + ((code & 1) ? sphere_offset : triangle_offset);
+  return (code & 1) ? RTCL_LEAF_SPHERES(block) : RTCL_LEAF_TRIANGLES(block);
+}
+
 Bvh8Node empty_node() {
   Bvh8Node node;
   for (int row = 0; row < 6; ++row)
@@ -107,7 +145,7 @@ inline void prefetch(const void* p) {
 class Flattener {
  public:
   Flattener(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count)
-      : tree_(tree), geometry_(geometry), merge_leaves_(merge_leaves), node_seen_(tree.nodes.size(), 0) {
+      : tree_(tree), geometry_(geometry), merge_leaves_(merge_leaves), node_seen_(tree.nodes.size()) {
     threads_ = thread_count ? thread_count : std::max(1u, std::thread::hardware_concurrency());
   }
 
@@ -126,17 +164,42 @@ class Flattener {
 
   // Pass 1: forms every wide node; blocks are recorded as sources.
   void walk() {
-    struct Todo {
-      std::uint32_t binary, wide, stack, depth;  // stack: entries its ancestors leave on the stack, worst case
-    };
-    // Each wide node but a lone leaf root consumes at least one inner binary
-    // node; a block takes at least one binary leaf.
-    out_.nodes.reserve(tree_.nodes.size() / 2 + 1);
-    triangle_sources_.reserve(tree_.nodes.size() / 2 + 1);
-    out_.nodes.emplace_back();
-    std::vector<Todo> todo{{0, 0, 0, 1}};
-    visit(0);
     const Bvh8Node empty = empty_node();
+    WalkOutput top;
+    std::vector<Deferred> deferred;
+    visit(0);
+    top.nodes.emplace_back();
+    walk_from({0, 0, 0, 1}, top, tree_.nodes.size() >= kSplitMinNodes ? &deferred : nullptr, empty);
+    std::vector<WalkOutput> parts(deferred.size());
+    std::vector<std::exception_ptr> errors(deferred.size());
+    std::atomic<std::size_t> next{0};
+    auto worker = [&] {
+      for (std::size_t k; (k = next.fetch_add(1)) < deferred.size();) {
+        try {
+          parts[k].nodes.emplace_back();
+          Todo root = deferred[k].todo;
+          root.wide = 0;
+          walk_from(root, parts[k], nullptr, empty);
+        } catch (...) {
+          errors[k] = std::current_exception();
+        }
+      }
+    };
+    std::vector<std::thread> helpers;
+    for (unsigned t = 1; t < std::min<std::size_t>(threads_, deferred.size()); ++t) helpers.emplace_back(worker);
+    worker();
+    for (std::thread& helper : helpers) helper.join();
+    for (const std::exception_ptr& e : errors)
+      if (e) std::rethrow_exception(e);
+    assemble(std::move(top), deferred, parts);
+  }
+
+  // Forms the wide nodes of the subtree from `root` (whose node out.nodes
+  // holds, at root.wide) depth first. With `deferred`, the wide nodes of
+  // depth kSplitDepth are left to parts: recorded there, their lanes'
+  // children filled in by assemble.
+  void walk_from(Todo root, WalkOutput& out, std::vector<Deferred>* deferred, const Bvh8Node& empty) {
+    std::vector<Todo> todo{root};
     while (!todo.empty()) {
       Todo t = todo.back();
       todo.pop_back();
@@ -144,10 +207,10 @@ class Flattener {
       // The kernel pushes the children it enters and pops the one it visits
       // next (kernels/accel/bvh.cl): entries peak at t.stack + children.
       auto children = static_cast<std::uint32_t>(slots.size());
-      out_.stack_size = std::max(out_.stack_size, t.stack + children);
+      out.stack_size = std::max(out.stack_size, t.stack + children);
       std::uint32_t below = t.stack + children - 1;  // left for each child's subtree
-      out_.depth = std::max(out_.depth, t.depth);
-      if (out_.stack_size > kBvhMaxStackSize)
+      out.depth = std::max(out.depth, t.depth);
+      if (out.stack_size > kBvhMaxStackSize)
         throw Error("BVH over " + geometry_.source + ": the tree needs a traversal stack of more than " +
                     std::to_string(kBvhMaxStackSize) + " entries (depth " + std::to_string(t.depth) +
                     "); lower SahConfig::max_sah_depth or PlocConfig::max_depth");
@@ -160,23 +223,65 @@ class Flattener {
           node.bounds[3 + a][lane] = s.bounds.upper[a];
         }
         if (s.leaf) {
-          node.child[lane] = record_block(s);
+          node.child[lane] = record_block(s, out, tree_);
+        } else if (deferred && t.depth + 1 == kSplitDepth) {
+          deferred->push_back({{s.node, 0, below, t.depth + 1}, t.wide, static_cast<std::uint32_t>(lane)});
         } else {
-          auto index = static_cast<std::uint32_t>(out_.nodes.size());
+          auto index = static_cast<std::uint32_t>(out.nodes.size());
           if (index > 0x7ffffffeu) fail("too many nodes");
-          out_.nodes.emplace_back();
+          out.nodes.emplace_back();
           node.child[lane] = static_cast<rtcl_i32>(index);
           todo.push_back({s.node, index, below, t.depth + 1});
         }
       }
       std::reverse(todo.begin() + static_cast<std::ptrdiff_t>(first_todo), todo.end());
-      out_.nodes[t.wide] = node;
+      out.nodes[t.wide] = node;
+    }
+  }
+
+  // The top's and the parts' nodes and sources in one tree: the top's
+  // first, then each part's in the order of `deferred`, their indices
+  // moved by what comes before them.
+  void assemble(WalkOutput top, const std::vector<Deferred>& deferred, std::vector<WalkOutput>& parts) {
+    std::size_t nodes = top.nodes.size(), triangles = top.triangle_sources.size(), spheres = top.sphere_sources.size();
+    for (const WalkOutput& part : parts) {
+      nodes += part.nodes.size();
+      triangles += part.triangle_sources.size();
+      spheres += part.sphere_sources.size();
+    }
+    if (nodes > 0x7fffffffu) fail("too many nodes");
+    out_.nodes = std::move(top.nodes);
+    out_.nodes.reserve(nodes);
+    triangle_sources_ = std::move(top.triangle_sources);
+    triangle_sources_.reserve(triangles);
+    sphere_sources_ = std::move(top.sphere_sources);
+    sphere_sources_.reserve(spheres);
+    out_.stack_size = top.stack_size;
+    out_.depth = top.depth;
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      WalkOutput& part = parts[k];
+      const auto node_offset = static_cast<std::uint32_t>(out_.nodes.size());
+      const auto triangle_offset = static_cast<std::uint32_t>(triangle_sources_.size());
+      const auto sphere_offset = static_cast<std::uint32_t>(sphere_sources_.size());
+      out_.nodes[deferred[k].parent].child[deferred[k].lane] = static_cast<rtcl_i32>(node_offset);
+      for (Bvh8Node& node : part.nodes) {
+        for (rtcl_i32& c : node.child)
+          if (c >= 0)
+            c += static_cast<rtcl_i32>(node_offset);
+          else if (c != RTCL_CHILD_EMPTY)
+            c = rebase_leaf(c, triangle_offset, sphere_offset);
+        out_.nodes.push_back(node);
+      }
+      triangle_sources_.insert(triangle_sources_.end(), part.triangle_sources.begin(), part.triangle_sources.end());
+      sphere_sources_.insert(sphere_sources_.end(), part.sphere_sources.begin(), part.sphere_sources.end());
+      out_.stack_size = std::max(out_.stack_size, part.stack_size);
+      out_.depth = std::max(out_.depth, part.depth);
     }
   }
 
   void visit(std::uint32_t n) {
     if (n >= tree_.nodes.size()) fail("child " + std::to_string(n) + " does not exist");
-    if (node_seen_[n]++) fail("node " + std::to_string(n) + " is reached twice");
+    if (node_seen_[n].exchange(1, std::memory_order_relaxed)) fail("node " + std::to_string(n) + " is reached twice");
   }
 
   // Binary node n as a slot. A leaf is checked against the tree alone (1..8
@@ -274,18 +379,19 @@ class Flattener {
     return true;
   }
 
-  // The leaf reference of the next block of s's kind, filled by the gather.
-  rtcl_i32 record_block(const Slot& s) {
+  // The leaf reference of the next block of s's kind in out, filled by the
+  // gather.
+  static rtcl_i32 record_block(const Slot& s, WalkOutput& out, const BuildTree& tree) {
     BlockSource source;
     source.count = 0;
     for (std::uint32_t k = 0; k < s.leaf_count; ++k) {
-      const BuildNode& leaf = tree_.nodes[s.leaves[k]];
+      const BuildNode& leaf = tree.nodes[s.leaves[k]];
       for (std::uint32_t i = 0; i < leaf.count; ++i) {
-        source.prims[source.count] = tree_.prims[leaf.first + i];
+        source.prims[source.count] = tree.prims[leaf.first + i];
         source.leaves[source.count++] = s.leaves[k];
       }
     }
-    std::vector<BlockSource>& sources = s.spheres ? sphere_sources_ : triangle_sources_;
+    std::vector<BlockSource>& sources = s.spheres ? out.sphere_sources : out.triangle_sources;
     sources.push_back(source);
     auto block = sources.size() - 1;
     return s.spheres ? RTCL_LEAF_SPHERES(block) : RTCL_LEAF_TRIANGLES(block);
@@ -410,7 +516,7 @@ class Flattener {
   const Geometry& geometry_;
   bool merge_leaves_;
   unsigned threads_ = 1;
-  std::vector<char> node_seen_;
+  std::vector<std::atomic<std::uint8_t>> node_seen_;  // by the walks, on several threads
   std::vector<BlockSource> triangle_sources_, sphere_sources_;  // per block of out_.blocks, same order
   std::vector<std::vector<std::uint64_t>> seen_;                // per gather thread: bit p = primitive p marked
   Bvh8 out_;

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rtcl/cl/device.hpp"
+#include "rtcl/default_init_allocator.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/scene/geometry.hpp"
 
@@ -36,9 +37,10 @@ inline void set_lane(SphereBlock& block, std::size_t lane, std::uint32_t prim, c
   block.prim[lane] = static_cast<rtcl_i32>(prim);
 }
 
+// Blocks are trivial: resize() leaves them unwritten for their filler.
 struct PrimitiveBlocks {
-  std::vector<TriangleBlock> triangles;
-  std::vector<SphereBlock> spheres;
+  std::vector<TriangleBlock, DefaultInitAllocator<TriangleBlock>> triangles;
+  std::vector<SphereBlock, DefaultInitAllocator<SphereBlock>> spheres;
 
   // Appends one block holding `prims` (1..8 ids, all triangles or all spheres
   // of `geometry`) and returns its leaf child reference (RTCL_LEAF_*).
