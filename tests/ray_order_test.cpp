@@ -1,6 +1,7 @@
-// Host ray orders (src/rtcl/render/ray_order.cpp): both are permutations,
+// Host ray orders (src/rtcl/render/ray_order.cpp): all are permutations,
 // the tile order matches the renderer's device order and keeps each group of
-// 8 in one tile row, and the Morton order makes consecutive rays alike.
+// 8 in one tile row, the packet-tile order makes each group of 8 a 4x2
+// block, and the Morton order makes consecutive rays alike.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -42,6 +43,32 @@ TEST(RayOrder, TileOrderGroupsOfEightAreOneTileRow) {
   }
   // the first 64 rays are the top-left 8x8 tile
   for (std::uint32_t i = 0; i < 64; ++i) EXPECT_EQ(order[i], (i / 8) * w + i % 8);
+}
+
+TEST(RayOrder, PacketTileOrderCoversEveryPixelOnce) {
+  for (auto [w, h] : {std::pair{1024u, 1024u}, {13u, 7u}, {8u, 8u}, {1u, 1u}, {0u, 5u}, {33u, 17u}}) {
+    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+    auto order = packet_tile_order(w, h);
+    ASSERT_EQ(order.size(), std::size_t{w} * h);
+    EXPECT_TRUE(is_permutation_of_iota(order));
+  }
+}
+
+// Away from the edges each group of eight is a 4x2 block, row by row, and
+// each run of 64 is one 8x8 tile, its blocks in rows.
+TEST(RayOrder, PacketTileOrderGroupsOfEightAre4x2Blocks) {
+  const std::uint32_t w = 64, h = 40;
+  auto order = packet_tile_order(w, h);
+  for (std::size_t g = 0; g < order.size(); g += 8) {
+    const std::uint32_t y0 = order[g] / w, x0 = order[g] % w;
+    EXPECT_EQ(x0 % 4, 0u) << "group " << g / 8;
+    EXPECT_EQ(y0 % 2, 0u) << "group " << g / 8;
+    for (std::uint32_t k = 0; k < 8; ++k) EXPECT_EQ(order[g + k], (y0 + k / 4) * w + x0 + k % 4) << "group " << g / 8;
+  }
+  for (std::uint32_t i = 0; i < 64; ++i) {
+    const std::uint32_t block = i / 8, lane = i % 8;
+    EXPECT_EQ(order[i], (2 * (block / 2) + lane / 4) * w + 4 * (block % 2) + lane % 4) << i;
+  }
 }
 
 std::vector<Ray> random_rays_in_unit_cube(std::size_t count, std::uint32_t seed) {

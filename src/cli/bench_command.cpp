@@ -30,6 +30,7 @@
 #include "distributed.hpp"
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/bench/ray_sets.hpp"
+#include "rtcl/render/ray_order.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/io/atomic_file.hpp"
@@ -114,7 +115,11 @@ std::vector<Hit> trace_once(const Accel& accel, Query query, std::span<const Ray
 
 SceneRays make_rays(const Device& device, const LoadedBenchScene& scene, int size, std::size_t check_rays) {
   SceneRays out;
-  out.sets[0] = bench::primary_rays(scene.camera, size, size);
+  {
+    std::vector<Ray> rows = bench::primary_rays(scene.camera, size, size);
+    auto side = static_cast<std::uint32_t>(size);
+    out.sets[0] = gather<Ray>(rows, packet_tile_order(side, side));
+  }
   // The primary hits that spawn the secondary rays: the BVH's (the check
   // below tests them against brute force like every other cell).
   std::vector<std::string> names = accel_names();

@@ -41,6 +41,23 @@ std::vector<std::uint32_t> tile_order(std::uint32_t width, std::uint32_t height)
   return order;
 }
 
+std::vector<std::uint32_t> packet_tile_order(std::uint32_t width, std::uint32_t height) {
+  constexpr std::uint32_t kTile = 8, kPacketWidth = 4, kPacketHeight = 2;
+  std::size_t count = static_cast<std::size_t>(width) * height;
+  if (count > 0xffffffffu)
+    throw Error("packet_tile_order: " + std::to_string(width) + "x" + std::to_string(height) +
+                " image has more than 2^32-1 pixels");
+  std::vector<std::uint32_t> order;
+  order.reserve(count);
+  for (std::uint32_t ty = 0; ty < height; ty += kTile)
+    for (std::uint32_t tx = 0; tx < width; tx += kTile)
+      for (std::uint32_t py = ty; py < std::min(ty + kTile, height); py += kPacketHeight)
+        for (std::uint32_t px = tx; px < std::min(tx + kTile, width); px += kPacketWidth)
+          for (std::uint32_t y = py; y < std::min(py + kPacketHeight, height); ++y)
+            for (std::uint32_t x = px; x < std::min(px + kPacketWidth, width); ++x) order.push_back(y * width + x);
+  return order;
+}
+
 std::uint64_t ray_morton_key(const Ray& ray, const Aabb& bounds) {
   float length = std::sqrt(ray.dx * ray.dx + ray.dy * ray.dy + ray.dz * ray.dz);
   float inv = length > 0.0f ? 1.0f / length : 0.0f;

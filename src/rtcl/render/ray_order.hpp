@@ -32,6 +32,16 @@ namespace rtcl {
 // order (rtcl_tile_order_pixel): a permutation of 0 .. width*height - 1.
 std::vector<std::uint32_t> tile_order(std::uint32_t width, std::uint32_t height);
 
+// Pixel indices (y * width + x) in packet-tile order: 8x8 tiles (rows of
+// tiles), each as eight 4x2-pixel packets (rows of packets), each packet
+// row by row; clipped at the image's edges. Eight consecutive rays are
+// then a 4x2 block, the most compact 8-pixel shape: the order of `rtcl
+// bench`'s primary rays, so that the packets it compares with Embree's
+// rtcIntersect8 are the ones Embree traces fastest (measured against rows
+// of 8x1 pixels, 1024^2, bunny, sponza, sibenik: rtcIntersect8 9-20%
+// faster, rtcl's packets within the run-to-run noise).
+std::vector<std::uint32_t> packet_tile_order(std::uint32_t width, std::uint32_t height);
+
 // The 60-bit Morton key of one ray (see above). Origins outside `bounds`
 // clamp to its faces; NaN components quantise to 0; a zero direction keys
 // as the direction (0, 0, 0).
