@@ -20,10 +20,15 @@
  * The fast level does not widen. */
 #define RTCL_SLAB_WIDEN (8.0f * FLT_EPSILON)
 
+/* One fused multiply-add per side (measured 1.00-1.02x the single-ray
+ * kernel time over nine bench/ sets against a multiply and a subtraction,
+ * README "Kernel levers on the single-ray BVH"): the widened value is the
+ * exact tn - |tn| * RTCL_SLAB_WIDEN rounded once, within half an ulp of it,
+ * as the two-step form's is. */
 inline void rtcl_widen_slab(float8* tn, float8* tf) {
 #ifndef RTCL_PRECISION_FAST
-  *tn = *tn - fabs(*tn) * RTCL_SLAB_WIDEN;
-  *tf = *tf + fabs(*tf) * RTCL_SLAB_WIDEN;
+  *tn = fma(-fabs(*tn), (float8)(RTCL_SLAB_WIDEN), *tn);
+  *tf = fma(fabs(*tf), (float8)(RTCL_SLAB_WIDEN), *tf);
 #endif
 }
 
@@ -110,8 +115,8 @@ inline int intersect_box1(global const float* b, const TraceRay* s, float tmax) 
   float tf = fmin((b[s->far_x] - s->ox) * s->ix,
                   fmin((b[s->far_y] - s->oy) * s->iy, fmin((b[s->far_z] - s->oz) * s->iz, tmax)));
 #ifndef RTCL_PRECISION_FAST
-  tn -= fabs(tn) * RTCL_SLAB_WIDEN;
-  tf += fabs(tf) * RTCL_SLAB_WIDEN;
+  tn = fma(-fabs(tn), RTCL_SLAB_WIDEN, tn);
+  tf = fma(fabs(tf), RTCL_SLAB_WIDEN, tf);
 #endif
   return tn <= tf;
 }
