@@ -21,13 +21,14 @@ bool is_permutation_of_iota(std::vector<std::uint32_t> order) {
   return true;
 }
 
-TEST(RayOrder, TileOrderCoversEveryPixelOnce) {
-  for (auto [w, h] : {std::pair{1024u, 1024u}, {13u, 7u}, {8u, 8u}, {1u, 1u}, {0u, 5u}, {33u, 17u}}) {
-    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
-    auto order = tile_order(w, h);
-    ASSERT_EQ(order.size(), std::size_t{w} * h);
-    EXPECT_TRUE(is_permutation_of_iota(order));
-  }
+TEST(RayOrder, TileOrdersCoverEveryPixelOnce) {
+  for (auto [w, h] : {std::pair{1024u, 1024u}, {13u, 7u}, {8u, 8u}, {1u, 1u}, {0u, 5u}, {33u, 17u}})
+    for (bool packets : {false, true}) {
+      SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) + (packets ? " packet tiles" : " tiles"));
+      auto order = packets ? packet_tile_order(w, h) : tile_order(w, h);
+      ASSERT_EQ(order.size(), std::size_t{w} * h);
+      EXPECT_TRUE(is_permutation_of_iota(order));
+    }
 }
 
 TEST(RayOrder, TileOrderGroupsOfEightAreOneTileRow) {
@@ -43,15 +44,6 @@ TEST(RayOrder, TileOrderGroupsOfEightAreOneTileRow) {
   }
   // the first 64 rays are the top-left 8x8 tile
   for (std::uint32_t i = 0; i < 64; ++i) EXPECT_EQ(order[i], (i / 8) * w + i % 8);
-}
-
-TEST(RayOrder, PacketTileOrderCoversEveryPixelOnce) {
-  for (auto [w, h] : {std::pair{1024u, 1024u}, {13u, 7u}, {8u, 8u}, {1u, 1u}, {0u, 5u}, {33u, 17u}}) {
-    SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
-    auto order = packet_tile_order(w, h);
-    ASSERT_EQ(order.size(), std::size_t{w} * h);
-    EXPECT_TRUE(is_permutation_of_iota(order));
-  }
 }
 
 // Away from the edges each group of eight is a 4x2 block, row by row, and
