@@ -352,6 +352,23 @@ TEST(Bvh, SahTreeDoesNotDependOnTheThreads) {
   }
 }
 
+// The boxes pass splits the triangles into parts (16384 and more each) and
+// moves each part's kept triangles down past the zero-area ones before it:
+// the same tree as one part, every other triangle stored once.
+TEST(Bvh, ZeroAreaTrianglesInEveryPartAreSkipped) {
+  Geometry g = soup_with_spheres(40000, 500, 9);
+  for (std::size_t i = 0; i < g.triangles.size(); i += 7) g.triangles[i].z = g.triangles[i].y;
+  BvhConfig one, two;
+  one.sah.thread_count = 1;
+  two.sah.thread_count = 2;
+  std::vector<double> a, b;
+  canonical(build_binary_bvh(g, one), 0, a);
+  BuildTree tree = build_binary_bvh(g, two);
+  canonical(tree, 0, b);
+  EXPECT_TRUE(a == b);
+  EXPECT_EQ(check_wide(flatten_bvh8(tree, g), g), "");
+}
+
 TEST(Bvh, MatchesReferenceOnBunny) { expect_real_mesh_matches("stanford_bunny/bunny.obj"); }
 TEST(Bvh, MatchesReferenceOnDragon) { expect_real_mesh_matches("stanford_dragon_100k/dragon.obj"); }
 TEST(Bvh, MatchesReferenceOnSponza) { expect_real_mesh_matches("sponza/sponza.obj"); }

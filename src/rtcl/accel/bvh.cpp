@@ -54,17 +54,41 @@ class BvhAccel final : public Accel {
 }  // namespace
 
 BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config) {
-  std::vector<std::uint32_t> ids = stored_primitives(geometry);
-  auto first_sphere = static_cast<std::size_t>(
-      std::partition_point(ids.begin(), ids.end(), [&](std::uint32_t p) { return p < geometry.triangles.size(); }) -
-      ids.begin());
+  // The stored primitives (stored_primitives' ids, triangles first) and
+  // their boxes in one pass over the triangles, each part writing from its
+  // own first triangle on; parts after a zero-area triangle move down.
+  const std::size_t triangles = geometry.triangles.size();
+  std::vector<std::uint32_t> ids(geometry.primitive_count());
   std::vector<Aabb> bounds(ids.size());
-  for_each_part(ids.size(), part_count(ids.size(), bvh_thread_count(config), kBoundsPartMin),
-                [&](unsigned, std::size_t begin, std::size_t end) {
-                  for (std::size_t i = begin; i < end; ++i)
-                    bounds[i] = i < first_sphere ? geometry.primitive_bounds(ids[i])
-                                                 : sphere_bounds(geometry.spheres[ids[i] - geometry.triangles.size()]);
-                });
+  const unsigned parts = part_count(triangles, bvh_thread_count(config), kBoundsPartMin);
+  std::vector<std::size_t> part_end(parts);
+  for_each_part(triangles, parts, [&](unsigned part, std::size_t begin, std::size_t end) {
+    std::size_t out = begin;
+    for (std::size_t i = begin; i < end; ++i) {
+      const glm::uvec3& t = geometry.triangles[i];
+      const glm::vec3 &a = geometry.vertices[t.x], &b = geometry.vertices[t.y], &c = geometry.vertices[t.z];
+      if (zero_area(a, b, c)) continue;
+      ids[out] = static_cast<std::uint32_t>(i);
+      bounds[out++] = Aabb{glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+    }
+    part_end[part] = out;
+  });
+  std::size_t first_sphere = 0;
+  for (unsigned part = 0; part < parts; ++part) {
+    const std::size_t begin = triangles * part / parts, kept = part_end[part] - begin;
+    if (first_sphere != begin) {
+      std::copy_n(ids.begin() + static_cast<std::ptrdiff_t>(begin), kept, ids.begin() + static_cast<std::ptrdiff_t>(first_sphere));
+      std::copy_n(bounds.begin() + static_cast<std::ptrdiff_t>(begin), kept,
+                  bounds.begin() + static_cast<std::ptrdiff_t>(first_sphere));
+    }
+    first_sphere += kept;
+  }
+  for (std::size_t j = 0; j < geometry.spheres.size(); ++j) {
+    ids[first_sphere + j] = static_cast<std::uint32_t>(triangles + j);
+    bounds[first_sphere + j] = sphere_bounds(geometry.spheres[j]);
+  }
+  ids.resize(first_sphere + geometry.spheres.size());
+  bounds.resize(ids.size());
   std::span<const Aabb> all_bounds(bounds);
   std::span<const std::uint32_t> all_ids(ids);
   return join(build_kind(all_bounds.first(first_sphere), all_ids.first(first_sphere), config),
