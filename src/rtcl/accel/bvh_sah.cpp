@@ -335,6 +335,33 @@ class SahBuilder {
     return store;
   }
 
+  // The root's partition: each half of the range partitioned as by
+  // partition(), on two threads when there are, then the first half's right
+  // run and the second half's left run exchanged (the shorter one's length
+  // of references). The same order, and so the same tree, on any number of
+  // threads.
+  std::uint32_t partition_halves(const Range& range, const Split& split, Range& left, Range& right) {
+    const std::uint32_t mid = range.begin + (range.end - range.begin) / 2;
+    const Range halves[2] = {{range.begin, mid, range.bounds, range.centres}, {mid, range.end, range.bounds, range.centres}};
+    Range sides[2][2] = {{left, right}, {left, right}};  // [half][left, right]: centre bounds only
+    std::uint32_t store[2] = {0, 0};
+    for_each_part(2, thread_count_ > 1 ? 2u : 1u, [&](unsigned, std::size_t begin, std::size_t end) {
+      for (std::size_t h = begin; h < end; ++h) store[h] = partition(halves[h], split, sides[h][0], sides[h][1]);
+    });
+    const std::uint32_t first_right = mid - store[0], second_left = store[1] - mid;
+    PrimRef* refs = refs_.get();
+    if (first_right <= second_left)
+      std::swap_ranges(refs + store[0], refs + mid, refs + store[1] - first_right);
+    else
+      std::swap_ranges(refs + mid, refs + store[1], refs + store[0]);
+    for (int side = 0; side < 2; ++side) {
+      Range& out = side == 0 ? left : right;
+      out.centres.grow(sides[0][side].centres);
+      out.centres.grow(sides[1][side].centres);
+    }
+    return store[0] + second_left;
+  }
+
   // Object median along the longest centroid axis: both halves non-empty.
   std::uint32_t median_split(const Range& range) {
     int axis = 0;
@@ -365,7 +392,9 @@ class SahBuilder {
     }
     Range left{range.begin, 0, Box::empty(), Box::empty()}, right{0, range.end, Box::empty(), Box::empty()};
     if (split.axis >= 0) {
-      left.end = right.begin = partition(range, split, left, right);
+      left.end = right.begin = range.end - range.begin == ref_count_ && ref_count_ >= kParallelBinMin
+                                   ? partition_halves(range, split, left, right)
+                                   : partition(range, split, left, right);
       left.bounds = split.left;
       right.bounds = split.right;
     }
