@@ -42,8 +42,9 @@ struct SahConfig {
   // With more than one thread, each subtree of at least this many
   // primitives is a task of its own (a thread that waits for work takes the
   // largest waiting one), and a root of at least 16384 primitives is binned
-  // by the threads together; thread_count bounds the threads in use (0 =
-  // all hardware threads). The tree does not depend on the threads.
+  // by the threads together and partitioned in two halves; thread_count
+  // bounds the threads in use (0 = all hardware threads). The tree does not
+  // depend on the threads.
   std::size_t parallel_min_primitives = 2048;
   unsigned thread_count = 0;
 };
