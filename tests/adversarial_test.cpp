@@ -24,6 +24,7 @@
 
 #include "rtcl/accel/accel.hpp"
 #include "support/closed_meshes.hpp"
+#include "support/error_of.hpp"
 #include "support/everywhere.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"
@@ -106,6 +107,22 @@ std::vector<ClosedCase> closed_cases() {
   for (glm::vec3 p : inside) moved_inside.push_back(glm::vec3(glm::dvec3(p) * 1000.0 + away));
   cases.push_back({moved, glm::vec3(away), moved_inside, true});
   return cases;
+}
+
+// A scene of zero-area triangles only has nothing to hit: every structure
+// refuses it with the one message, whether validate or its own build finds
+// the triangles flat (the BVH's pass over them), and also when the flat
+// ones fill several build parts (over 16384 each).
+TEST(Adversarial, EveryStructureRefusesASceneOfZeroAreaTrianglesOnly) {
+  for (std::size_t count : {std::size_t{3}, std::size_t{40000}}) {
+    Geometry g = random_soup(count, 31);
+    g.source = "flat soup";
+    for (glm::uvec3& t : g.triangles) t.z = t.y;
+    for (const std::string& name : accel_names()) {
+      std::string e = error_of([&] { make_accel(test_device(), name, g); });
+      EXPECT_NE(e.find("flat soup: empty scene"), std::string::npos) << name << ", " << count << ": " << e;
+    }
+  }
 }
 
 TEST(Adversarial, ClosedMeshesDoNotLeakFromInside) {

@@ -88,6 +88,7 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config) {
     bounds[first_sphere + j] = sphere_bounds(geometry.spheres[j]);
   }
   ids.resize(first_sphere + geometry.spheres.size());
+  if (ids.empty()) throw empty_scene_error(geometry);
   bounds.resize(ids.size());
   std::span<const Aabb> all_bounds(bounds);
   std::span<const std::uint32_t> all_ids(ids);
@@ -122,9 +123,10 @@ std::vector<std::string> bvh_defines(const Geometry& geometry, const Bvh8& bvh) 
 std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config,
                                 std::string name, const AccelConfig& accel_config) {
   auto start = std::chrono::steady_clock::now();
-  GeometryReport report = validate(geometry);
-  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, config), geometry, config.merge_leaves,
-                         bvh_thread_count(config));
+  GeometryReport report = validate(geometry, ZeroAreaTest::by_caller);
+  BuildTree tree = build_binary_bvh(geometry, config);
+  report.zero_area_triangles = geometry.primitive_count() - tree.prims.size();
+  Bvh8 bvh = flatten_bvh8(tree, geometry, config.merge_leaves, bvh_thread_count(config));
   AccelStats stats = bvh_stats(geometry, report, bvh, start);
   std::vector<std::string> defines = bvh_defines(geometry, bvh);
   return std::make_unique<BvhAccel>(device, std::move(name), config.traversal, std::move(defines), bvh, stats,

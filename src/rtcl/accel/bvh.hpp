@@ -63,7 +63,8 @@ struct Bvh8 {
 // The binary tree over the geometry's stored primitives (zero-area
 // triangles skipped); leaves hold primitive ids. Triangles and spheres are
 // built separately and joined under one root, so no leaf mixes them.
-// Geometry must have passed validate().
+// Geometry must have passed validate() (ZeroAreaTest::by_caller suffices:
+// a scene of zero-area triangles only throws empty_scene_error here).
 BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config = {});
 
 // Collapses the binary tree into 8-wide nodes: each wide node takes the two

@@ -61,7 +61,7 @@ bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y
 // Vertices or triangles per host thread in validate (parallel.hpp).
 constexpr std::size_t kValidatePartMin = 16384;
 
-GeometryReport validate(const Geometry& g) {
+GeometryReport validate(const Geometry& g, ZeroAreaTest zero_area_test) {
   GeometryReport report;
   for_each_part(g.vertices.size(), part_count(g.vertices.size(), 0, kValidatePartMin),
                 [&](unsigned, std::size_t begin, std::size_t end) {
@@ -78,7 +78,7 @@ GeometryReport validate(const Geometry& g) {
         if (t[k] >= g.vertices.size())
           throw Error(g.source + ": triangle " + std::to_string(i) + " uses vertex index " + std::to_string(t[k]) +
                       ", but there are only " + std::to_string(g.vertices.size()) + " vertices");
-      if (zero_area(g, i)) ++zero_area_counts[part];
+      if (zero_area_test == ZeroAreaTest::in_validate && zero_area(g, i)) ++zero_area_counts[part];
     }
   });
   for (std::size_t count : zero_area_counts) report.zero_area_triangles += count;
@@ -87,9 +87,12 @@ GeometryReport validate(const Geometry& g) {
     if (!finite(s.center) || !std::isfinite(s.radius) || !(s.radius > 0.0f))
       throw Error(g.source + ": sphere " + std::to_string(i) + " needs a finite centre and a positive radius");
   }
-  if (g.primitive_count() == report.zero_area_triangles)
-    throw Error(g.source + ": empty scene: no triangle with non-zero area and no sphere");
+  if (g.primitive_count() == report.zero_area_triangles) throw empty_scene_error(g);
   return report;
+}
+
+Error empty_scene_error(const Geometry& g) {
+  return Error(g.source + ": empty scene: no triangle with non-zero area and no sphere");
 }
 
 }  // namespace rtcl

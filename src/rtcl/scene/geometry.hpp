@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 
 #include "rtcl/bounds/aabb.hpp"
+#include "rtcl/error.hpp"
 
 namespace rtcl {
 
@@ -38,12 +39,22 @@ struct GeometryReport {
   std::size_t zero_area_triangles = 0;  // skipped by every structure; ids keep file order
 };
 
+// Whether validate tests every triangle for zero area, or leaves it to a
+// caller that tests them anyway (the BVH build's pass over the triangles):
+// that caller then counts them and throws empty_scene_error for a scene of
+// zero-area triangles only.
+enum class ZeroAreaTest { in_validate, by_caller };
+
 // Throws Error naming geometry.source and the first offending element for:
 // NaN/Inf vertex coordinates, out-of-range indices, NaN/Inf or non-positive
 // sphere radius or centre, and a scene with nothing to hit (no primitive, or
 // only zero-area triangles). Counts zero-area triangles (exactly zero in
-// double precision).
-GeometryReport validate(const Geometry& geometry);
+// double precision); with ZeroAreaTest::by_caller it neither counts them
+// nor rejects a scene of them only.
+GeometryReport validate(const Geometry& geometry, ZeroAreaTest zero_area_test = ZeroAreaTest::in_validate);
+
+// The error for a scene with nothing to hit.
+Error empty_scene_error(const Geometry& geometry);
 
 // True when the triangle's area is exactly zero in double precision.
 bool zero_area(const Geometry& geometry, std::size_t triangle);
