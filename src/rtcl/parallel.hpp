@@ -1,8 +1,10 @@
-// Contiguous parts of a loop over [0, count) on host threads: the builders'
-// passes over every primitive or vertex.
+// Loops over [0, count) on host threads: contiguous parts (the builders'
+// passes over every primitive or vertex) or single indices handed to
+// whichever thread is free (work items of uneven size).
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <exception>
 #include <thread>
@@ -42,6 +44,30 @@ void for_each_part(std::size_t count, unsigned parts, Fn&& fn) {
   helpers.reserve(parts - 1);
   for (unsigned part = 1; part < parts; ++part) helpers.emplace_back(run, part);
   run(0);
+  for (std::thread& helper : helpers) helper.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+// Calls fn(k) for every k in [0, count), each on whichever of `threads`
+// threads (the caller's among them; at most count) takes it next. After all
+// have returned, rethrows the exception of the lowest k that threw.
+template <class Fn>
+void for_each_index(std::size_t count, unsigned threads, Fn&& fn) {
+  std::vector<std::exception_ptr> errors(count);
+  std::atomic<std::size_t> next{0};
+  auto run = [&] {
+    for (std::size_t k; (k = next.fetch_add(1, std::memory_order_relaxed)) < count;) {
+      try {
+        fn(k);
+      } catch (...) {
+        errors[k] = std::current_exception();
+      }
+    }
+  };
+  std::vector<std::thread> helpers;
+  for (std::size_t t = 1; t < std::min<std::size_t>(std::max(threads, 1u), count); ++t) helpers.emplace_back(run);
+  run();
   for (std::thread& helper : helpers) helper.join();
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);

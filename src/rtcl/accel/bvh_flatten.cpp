@@ -21,7 +21,6 @@
 #include <array>
 #include <atomic>
 #include <bit>
-#include <exception>
 #include <limits>
 #include <string>
 #include <thread>
@@ -29,6 +28,7 @@
 
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/parallel.hpp"
 
 namespace rtcl {
 
@@ -171,26 +171,10 @@ class Flattener {
     top.nodes.emplace_back();
     walk_from({0, 0, 0, 1}, top, tree_.nodes.size() >= kSplitMinNodes ? &deferred : nullptr, empty);
     std::vector<WalkOutput> parts(deferred.size());
-    std::vector<std::exception_ptr> errors(deferred.size());
-    std::atomic<std::size_t> next{0};
-    auto worker = [&] {
-      for (std::size_t k; (k = next.fetch_add(1)) < deferred.size();) {
-        try {
-          parts[k].nodes.emplace_back();
-          Todo root = deferred[k].todo;
-          root.wide = 0;
-          walk_from(root, parts[k], nullptr, empty);
-        } catch (...) {
-          errors[k] = std::current_exception();
-        }
-      }
-    };
-    std::vector<std::thread> helpers;
-    for (unsigned t = 1; t < std::min<std::size_t>(threads_, deferred.size()); ++t) helpers.emplace_back(worker);
-    worker();
-    for (std::thread& helper : helpers) helper.join();
-    for (const std::exception_ptr& e : errors)
-      if (e) std::rethrow_exception(e);
+    for_each_index(deferred.size(), threads_, [&](std::size_t k) {
+      parts[k].nodes.emplace_back();
+      walk_from(deferred[k].todo, parts[k], nullptr, empty);
+    });
     assemble(std::move(top), deferred, parts);
   }
 
@@ -405,21 +389,11 @@ class Flattener {
     std::size_t blocks = triangle_sources_.size() + sphere_sources_.size();
     unsigned parts = blocks < kParallelMinBlocks ? 1u : threads_;
     seen_.assign(parts, std::vector<std::uint64_t>(geometry_.primitive_count() / 64 + 1, 0));
-    std::vector<std::exception_ptr> errors(parts);
-    auto part = [&](unsigned k) {
-      try {
-        gather_triangles(seen_[k], triangle_sources_.size() * k / parts, triangle_sources_.size() * (k + 1) / parts);
-        gather_spheres(seen_[k], sphere_sources_.size() * k / parts, sphere_sources_.size() * (k + 1) / parts);
-      } catch (...) {
-        errors[k] = std::current_exception();
-      }
-    };
-    std::vector<std::thread> helpers;
-    for (unsigned k = 1; k < parts; ++k) helpers.emplace_back(part, k);
-    part(0);
-    for (std::thread& helper : helpers) helper.join();
-    for (const std::exception_ptr& e : errors)
-      if (e) std::rethrow_exception(e);
+    // part k: the k-th share of each kind's blocks, on its own thread
+    for_each_part(parts, parts, [&](unsigned k, std::size_t, std::size_t) {
+      gather_triangles(seen_[k], triangle_sources_.size() * k / parts, triangle_sources_.size() * (k + 1) / parts);
+      gather_spheres(seen_[k], sphere_sources_.size() * k / parts, sphere_sources_.size() * (k + 1) / parts);
+    });
   }
 
   void gather_triangles(std::vector<std::uint64_t>& seen, std::size_t begin, std::size_t end) {

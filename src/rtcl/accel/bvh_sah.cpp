@@ -182,7 +182,7 @@ class SahBuilder {
   // and the bins that matter are those of the large nodes near the root.
   // Not inlined: its bins (~28 KB a set) must not sit in every frame of the
   // recursion.
-  [[gnu::noinline]] Split find_split(const Range& range, bool whole_range) const {
+  [[gnu::noinline]] Split find_split(const Range& range, bool root) const {
     const std::uint32_t n = range.end - range.begin;
     BinMap map;
     map.count = std::min(config_.bin_count, std::max(8u, n / 8));
@@ -198,7 +198,7 @@ class SahBuilder {
     }
     Bins bins;
     bins.clear(map.count);
-    if (whole_range && thread_count_ > 1 && n >= kParallelBinMin) {
+    if (root && thread_count_ > 1 && n >= kParallelBinMin) {
       // the root: no other thread has work yet, so each bins a part
       const unsigned parts = part_count(n, thread_count_, kParallelBinMin / 2);
       std::vector<std::unique_ptr<Bins>> part_bins(parts);
@@ -378,10 +378,11 @@ class SahBuilder {
   // subtree of its own on the task list when more than one thread builds.
   void build(std::vector<BuildNode>& nodes, std::uint32_t node, const Range& range, std::uint32_t depth) {
     const std::uint32_t n = range.end - range.begin;
+    const bool root = n == ref_count_;
     const float area = range.bounds.area();
     Split split;
     if (n > 1 && depth < config_.max_sah_depth && !(n <= config_.max_leaf_size && leaf_wins_any_split(range, area)))
-      split = find_split(range, range.end - range.begin == ref_count_);
+      split = find_split(range, root);
     if (n <= config_.max_leaf_size &&
         (split.axis < 0 || area * blocks(n) <= config_.node_cost * area + split.cost)) {
       BuildNode& leaf = nodes[node];
@@ -392,9 +393,8 @@ class SahBuilder {
     }
     Range left{range.begin, 0, Box::empty(), Box::empty()}, right{0, range.end, Box::empty(), Box::empty()};
     if (split.axis >= 0) {
-      left.end = right.begin = range.end - range.begin == ref_count_ && ref_count_ >= kParallelBinMin
-                                   ? partition_halves(range, split, left, right)
-                                   : partition(range, split, left, right);
+      left.end = right.begin = root && n >= kParallelBinMin ? partition_halves(range, split, left, right)
+                                                             : partition(range, split, left, right);
       left.bounds = split.left;
       right.bounds = split.right;
     }

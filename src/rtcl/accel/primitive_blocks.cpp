@@ -5,14 +5,8 @@
 #include <limits>
 
 #include "rtcl/error.hpp"
-#include "rtcl/parallel.hpp"
 
 namespace rtcl {
-
-namespace {
-// Triangles per host thread in stored_primitives (parallel.hpp).
-constexpr std::size_t kStoredPartMin = 16384;
-}  // namespace
 
 TriangleBlock empty_triangle_block() {
   TriangleBlock b;
@@ -88,16 +82,10 @@ PrimitiveBlocks in_order_blocks(const Geometry& geometry, const std::vector<std:
 }
 
 std::vector<std::uint32_t> stored_primitives(const Geometry& g) {
-  const unsigned parts = part_count(g.triangles.size(), 0, kStoredPartMin);
-  std::vector<std::vector<std::uint32_t>> kept(parts);
-  for_each_part(g.triangles.size(), parts, [&](unsigned part, std::size_t begin, std::size_t end) {
-    kept[part].reserve(end - begin);
-    for (std::size_t i = begin; i < end; ++i)
-      if (!zero_area(g, i)) kept[part].push_back(static_cast<std::uint32_t>(i));
-  });
   std::vector<std::uint32_t> ids;
   ids.reserve(g.primitive_count());
-  for (const std::vector<std::uint32_t>& part : kept) ids.insert(ids.end(), part.begin(), part.end());
+  for (std::size_t i = 0; i < g.triangles.size(); ++i)
+    if (!zero_area(g, i)) ids.push_back(static_cast<std::uint32_t>(i));
   for (std::size_t i = 0; i < g.spheres.size(); ++i) ids.push_back(static_cast<std::uint32_t>(g.triangles.size() + i));
   return ids;
 }

@@ -56,10 +56,10 @@ bool zero_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
 
 namespace {
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-}  // namespace
 
 // Vertices or triangles per host thread in validate (parallel.hpp).
 constexpr std::size_t kValidatePartMin = 16384;
+}  // namespace
 
 GeometryReport validate(const Geometry& g, ZeroAreaTest zero_area_test) {
   GeometryReport report;
