@@ -84,6 +84,8 @@ TEST(AccelOptions, BadOptionsNameTheStructureAndTheOption) {
   EXPECT_NE(error_of_spec("bvh:bin_count=1").find("bin_count must be in [2, 256]"), std::string::npos);
   EXPECT_NE(error_of_spec("bvh:bin_count=2.5").find("bin_count must be an integer"), std::string::npos);
   EXPECT_NE(error_of_spec("bvh:merge_leaves=maybe").find("merge_leaves must be true or false"), std::string::npos);
+  EXPECT_NE(error_of_spec("bvh:presplit=-1").find("presplit must be in [0, 1024]"), std::string::npos);
+  EXPECT_NE(error_of_spec("bvh-ploc:presplit=nan").find("presplit"), std::string::npos);
   EXPECT_NE(error_of_spec("grid:lambda=1,lambda=2").find("lambda given twice"), std::string::npos);
   EXPECT_NE(error_of_spec("grid:").find("expected key=value"), std::string::npos);
   EXPECT_NE(error_of_spec("grid:lambda").find("expected key=value"), std::string::npos);

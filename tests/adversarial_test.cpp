@@ -1,5 +1,5 @@
-// Correctness at the extremes, for every structure in accel_names(), closest
-// and any hit. Three kinds of expectation:
+// Correctness at the extremes, for every structure in tested_structures(),
+// closest and any hit. Three kinds of expectation:
 //  - exact ones where the geometry makes the answer exact (dyadic
 //    coordinates, axis-parallel rays: the hit t is exactly known);
 //  - bit-for-bit agreement with brute force: every structure runs the same
@@ -118,7 +118,7 @@ TEST(Adversarial, EveryStructureRefusesASceneOfZeroAreaTrianglesOnly) {
     Geometry g = random_soup(count, 31);
     g.source = "flat soup";
     for (glm::uvec3& t : g.triangles) t.z = t.y;
-    for (const std::string& name : accel_names()) {
+    for (const std::string& name : tested_structures()) {
       std::string e = error_of([&] { make_accel(test_device(), name, g); });
       EXPECT_NE(e.find("flat soup: empty scene"), std::string::npos) << name << ", " << count << ": " << e;
     }
@@ -290,7 +290,7 @@ TEST(Adversarial, SignOfZeroDirectionComponentsDoesNotMatter) {
         r.oy = 4.0f * r.oy + 2.0f;
         r.oz = 2.0f * r.oz + 1.5f;
       }
-    for (const std::string& name : accel_names()) {
+    for (const std::string& name : tested_structures()) {
       auto accel = make_accel(test_device(), name, *g);
       for (Query query : {Query::closest, Query::any}) {
         std::vector<Hit> hits = run_query(*accel, rays, query);
@@ -461,7 +461,7 @@ TEST(Adversarial, IntervalEndsAtAHitIncludeItExactly) {
   g.vertices.insert(g.vertices.end(), ball.vertices.begin(), ball.vertices.end());
   for (auto t : ball.triangles) g.triangles.push_back(t + glm::uvec3(base));
   std::vector<Ray> plain = random_rays(g, 3000, 22);
-  for (const std::string& name : accel_names()) {
+  for (const std::string& name : tested_structures()) {
     SCOPED_TRACE(name);
     auto accel = make_accel(test_device(), name, g);
     std::vector<Hit> first = run_query(*accel, plain, Query::closest);
@@ -666,7 +666,7 @@ TEST(Adversarial, InvalidRaysMissWithoutHanging) {
     rays.push_back(valid[0]);
   }
   for (Precision level : test_precisions())
-  for (const std::string& name : accel_names()) {
+  for (const std::string& name : tested_structures()) {
     auto accel = make_accel(test_device(), name, g, {level});
     for (Query query : {Query::closest, Query::any}) {
       std::vector<Hit> hits = run_query(*accel, rays, query);

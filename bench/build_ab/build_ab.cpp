@@ -15,7 +15,8 @@
 // means rtcl builds faster), then the medians of rtcl's phases (validate,
 // the binary build, the flatten).
 //
-// Environment: RTCL_SCENES_DIR.
+// Environment: RTCL_SCENES_DIR; AB_PRESPLIT (the bvh's presplit option,
+// default 0).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -61,7 +62,7 @@ std::vector<double> rtcl_build_ms(const Geometry& geometry, const BvhConfig& con
   const Clock::time_point validated = Clock::now();
   BuildTree tree = build_binary_bvh(geometry, config);
   const Clock::time_point built = Clock::now();
-  Bvh8 bvh = flatten_bvh8(tree, geometry, config.merge_leaves, bvh_thread_count(config));
+  Bvh8 bvh = flatten_bvh8(tree, geometry, config.merge_leaves, bvh_thread_count(config), config.presplit > 0.0f);
   const Clock::time_point flattened = Clock::now();
   if (bvh.nodes.empty()) throw Error("empty BVH");
   return {ms(start, flattened), ms(start, validated), ms(validated, built), ms(built, flattened)};
@@ -86,7 +87,8 @@ int run(int argc, char** argv) {
   const int rounds = parse_rounds(argv[2]);
   const std::string scenes_dir = scenes_dir_or(RTCL_BUILD_AB_SCENES_DIR);
   const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-  const BvhConfig config;  // the "bvh" structure's defaults: SAH on all hardware threads
+  BvhConfig config;  // the "bvh" structure's defaults: SAH on all hardware threads
+  if (const char* presplit = std::getenv("AB_PRESPLIT")) config.presplit = std::strtof(presplit, nullptr);
   for (const std::string& name : scenes)
     if (name.rfind("soup:", 0) != 0 && !find_scene_spec(name))
       throw Error("scene '" + name + "': neither a bench/ scene nor soup:N");

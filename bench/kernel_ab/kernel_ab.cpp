@@ -1,8 +1,13 @@
 // rtcl_kernel_ab: two or more versions of the kernels/ tree timed against
 // each other in one process, launch by launch, on the bench/ scenes' rays.
 //
-//   rtcl_kernel_ab SCENES ROUNDS KERNEL_DIR...
+//   rtcl_kernel_ab SCENES ROUNDS KERNEL_DIR[#ACCEL_SPEC]...
 //   e.g. rtcl_kernel_ab bunny,sponza,sibenik 15 /tmp/kernels-before kernels
+//        rtcl_kernel_ab sponza 15 'kernels#bvh' 'kernels#bvh:node_cost=0.35'
+//
+// A version's ACCEL_SPEC (default $AB_ACCEL, else bvh) is the structure and
+// its build options as `--accel` takes them, so build options are compared
+// the same way as kernels (their hits may then differ in ties).
 //
 // Each KERNEL_DIR is a copy of kernels/ (RTCL_KERNEL_DIR is set to it while
 // its structure's programs are built; programs are cached by source, so the
@@ -54,14 +59,25 @@ using namespace rtcl::bench;
 
 int run(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: rtcl_kernel_ab SCENES ROUNDS KERNEL_DIR...  (e.g. bunny,sponza 15 old/ kernels/)\n");
+    std::fprintf(stderr, "usage: rtcl_kernel_ab SCENES ROUNDS KERNEL_DIR[#ACCEL_SPEC]...  (e.g. bunny,sponza 15 old/ kernels/)\n");
     return 2;
   }
   const std::vector<std::string> scenes = split(argv[1]);
   const int rounds = parse_rounds(argv[2]);
-  const std::vector<std::string> versions(argv + 3, argv + argc);
   const char* accel_env = std::getenv("AB_ACCEL");
   const std::string accel_name = accel_env && *accel_env ? accel_env : "bvh";
+  struct Version {
+    std::string kernel_dir, accel_spec;
+  };
+  std::vector<Version> versions;
+  for (int i = 3; i < argc; ++i) {
+    const std::string arg = argv[i];
+    const std::size_t hash = arg.find('#');
+    if (hash == std::string::npos)
+      versions.push_back({arg, accel_name});
+    else
+      versions.push_back({arg.substr(0, hash), arg.substr(hash + 1)});
+  }
   const char* res_env = std::getenv("RTCL_BENCH_RES");
   const int res = res_env && *res_env ? std::atoi(res_env) : 512;
   if (res < 1) throw Error("RTCL_BENCH_RES must be a positive number");
@@ -81,13 +97,13 @@ int run(int argc, char** argv) {
     validate(geometry);
 
     std::vector<std::unique_ptr<Accel>> accels;
-    for (const std::string& dir : versions) {
-      setenv("RTCL_KERNEL_DIR", dir.c_str(), 1);
-      accels.push_back(make_accel(device, accel_name, geometry));
+    for (const Version& version : versions) {
+      setenv("RTCL_KERNEL_DIR", version.kernel_dir.c_str(), 1);
+      accels.push_back(make_accel(device, version.accel_spec, geometry));
     }
     // One launch of version v over `rays`; its hits into *hits when given.
     auto launch = [&](std::size_t v, Query query, const std::vector<Ray>& rays, std::vector<Hit>* hits) {
-      setenv("RTCL_KERNEL_DIR", versions[v].c_str(), 1);
+      setenv("RTCL_KERNEL_DIR", versions[v].kernel_dir.c_str(), 1);
       cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), "rays");
       cl::Buffer hit_buffer = device.allocate(rays.size() * sizeof(Hit), "hits");
       accels[v]->trace(query, ray_buffer, hit_buffer, rays.size()).wait();

@@ -58,7 +58,7 @@ void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, cons
     AccelConfig config{level};
     auto brute = make_accel(device, "brute", geometry, config);
     std::vector<Hit> brute_hits[2] = {run_query(*brute, rays, Query::closest), run_query(*brute, rays, Query::any)};
-    for (const std::string& name : accel_names()) {
+    for (const std::string& name : tested_structures()) {
       auto accel = name == "brute" ? nullptr : make_accel(device, name, geometry, config);
       std::vector<std::pair<Coherence, Query>> calls = {{Coherence::incoherent, Query::closest},
                                                         {Coherence::incoherent, Query::any}};

@@ -21,6 +21,12 @@ const Device& test_device() {
   return device;
 }
 
+std::vector<std::string> tested_structures() {
+  std::vector<std::string> names = accel_names();
+  names.push_back("bvh:presplit=1");
+  return names;
+}
+
 std::vector<Precision> test_precisions() {
   static const std::vector<Precision> levels = [] {
     std::vector<Precision> chosen = {Precision::robust, Precision::exact, Precision::fast};

@@ -24,6 +24,11 @@ const Device& test_device();
 // device code, which the sanitizers do not instrument.
 std::vector<Precision> test_precisions();
 
+// What the registry-wide correctness suites build: every registered
+// structure (accel_names()), and the build options that change what a
+// traversal meets: "bvh:presplit=1" (a triangle in several leaves).
+std::vector<std::string> tested_structures();
+
 // Absolute path of a file under ../shared/scenes.
 std::string scene_path(const std::string& relative);
 

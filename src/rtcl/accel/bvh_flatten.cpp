@@ -144,8 +144,13 @@ inline void prefetch(const void* p) {
 
 class Flattener {
  public:
-  Flattener(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count)
-      : tree_(tree), geometry_(geometry), merge_leaves_(merge_leaves), node_seen_(tree.nodes.size()) {
+  Flattener(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count,
+            bool split_references)
+      : tree_(tree),
+        geometry_(geometry),
+        merge_leaves_(merge_leaves),
+        split_references_(split_references),
+        node_seen_(tree.nodes.size()) {
     threads_ = thread_count ? thread_count : std::max(1u, std::thread::hardware_concurrency());
   }
 
@@ -207,7 +212,7 @@ class Flattener {
           node.bounds[3 + a][lane] = s.bounds.upper[a];
         }
         if (s.leaf) {
-          node.child[lane] = record_block(s, out, tree_);
+          node.child[lane] = record_block(s, out, tree_, split_references_);
         } else if (deferred && t.depth + 1 == kSplitDepth) {
           deferred->push_back({{s.node, 0, below, t.depth + 1}, t.wide, static_cast<std::uint32_t>(lane)});
         } else {
@@ -364,14 +369,19 @@ class Flattener {
   }
 
   // The leaf reference of the next block of s's kind in out, filled by the
-  // gather.
-  static rtcl_i32 record_block(const Slot& s, WalkOutput& out, const BuildTree& tree) {
+  // gather. With split references, two parts of one triangle in s's leaves
+  // take one lane.
+  static rtcl_i32 record_block(const Slot& s, WalkOutput& out, const BuildTree& tree, bool split_references) {
     BlockSource source;
     source.count = 0;
     for (std::uint32_t k = 0; k < s.leaf_count; ++k) {
       const BuildNode& leaf = tree.nodes[s.leaves[k]];
       for (std::uint32_t i = 0; i < leaf.count; ++i) {
-        source.prims[source.count] = tree.prims[leaf.first + i];
+        const std::uint32_t p = tree.prims[leaf.first + i];
+        if (split_references && std::find(source.prims.begin(), source.prims.begin() + source.count, p) !=
+                                    source.prims.begin() + source.count)
+          continue;
+        source.prims[source.count] = p;
         source.leaves[source.count++] = s.leaves[k];
       }
     }
@@ -431,9 +441,10 @@ class Flattener {
       const glm::uvec3& t = geometry_.triangles[p];
       const glm::vec3 &a = geometry_.vertices[t.x], &b = geometry_.vertices[t.y], &c = geometry_.vertices[t.z];
       const Aabb& box = tree_.nodes[source.leaves[lane]].bounds;
-      if (!box.contains(a) || !box.contains(b) || !box.contains(c)) fail_outside(source.leaves[lane], p);
+      if (split_references_ ? !meets(box, a, b, c) : !box.contains(a) || !box.contains(b) || !box.contains(c))
+        fail_outside(source.leaves[lane], p);
       if (zero_area(a, b, c)) fail("zero-area triangle " + std::to_string(p) + " is in a leaf");
-      mark(seen, p);
+      mark(seen, p, split_references_);
       set_lane(out, lane, p, a, b, c);
     }
     out_.blocks.triangles[block] = out;
@@ -447,7 +458,7 @@ class Flattener {
         std::uint32_t p = source.prims[lane];
         if (!tree_.nodes[source.leaves[lane]].bounds.contains(geometry_.primitive_bounds(p)))
           fail_outside(source.leaves[lane], p);
-        mark(seen, p);
+        mark(seen, p, false);
         set_lane(out, lane, p, geometry_.spheres[p - geometry_.triangles.size()]);
       }
       out_.blocks.spheres[block] = out;
@@ -455,23 +466,33 @@ class Flattener {
   }
 
   [[noreturn]] void fail_outside(std::uint32_t leaf, std::uint32_t p) const {
-    fail("leaf " + std::to_string(leaf) + " does not contain primitive " + std::to_string(p));
+    fail("leaf " + std::to_string(leaf) + (split_references_ ? " does not meet primitive " : " does not contain primitive ") +
+         std::to_string(p));
   }
 
-  // Sets p's bit in one thread's marks.
-  void mark(std::vector<std::uint64_t>& seen, std::uint32_t p) const {
+  // Whether box and the box of triangle (a, b, c) share a point: a leaf
+  // that holds a part of a split triangle (bvh_presplit.hpp) holds at least
+  // that.
+  static bool meets(const Aabb& box, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
+    const glm::vec3 lower = glm::min(a, glm::min(b, c)), upper = glm::max(a, glm::max(b, c));
+    return glm::all(glm::lessThanEqual(box.lower, upper)) && glm::all(glm::lessThanEqual(lower, box.upper));
+  }
+
+  // Sets p's bit in one thread's marks; a second mark fails unless
+  // `may_repeat`.
+  void mark(std::vector<std::uint64_t>& seen, std::uint32_t p, bool may_repeat) const {
     std::uint64_t bit = std::uint64_t(1) << (p % 64);
-    if (seen[p / 64] & bit) fail("primitive " + std::to_string(p) + " is in two leaves");
+    if ((seen[p / 64] & bit) && !may_repeat) fail("primitive " + std::to_string(p) + " is in two leaves");
     seen[p / 64] |= bit;
   }
 
-  // Pass 3: no primitive marked by two threads, and the unmarked ones are
-  // exactly the zero-area triangles.
+  // Pass 3: no primitive marked by two threads (unless references are
+  // split), and the unmarked ones are exactly the zero-area triangles.
   void check_every_primitive_once() {
     std::vector<std::uint64_t>& all = seen_[0];
     for (std::size_t k = 1; k < seen_.size(); ++k)
       for (std::size_t w = 0; w < all.size(); ++w) {
-        if (std::uint64_t twice = all[w] & seen_[k][w])
+        if (std::uint64_t twice = split_references_ ? 0 : all[w] & seen_[k][w])
           fail("primitive " + std::to_string(64 * w + static_cast<std::size_t>(std::countr_zero(twice))) +
                " is in two leaves");
         all[w] |= seen_[k][w];
@@ -489,6 +510,7 @@ class Flattener {
   const BuildTree& tree_;
   const Geometry& geometry_;
   bool merge_leaves_;
+  bool split_references_;  // a triangle may sit in several leaves (bvh_presplit.hpp)
   unsigned threads_ = 1;
   std::vector<std::atomic<std::uint8_t>> node_seen_;  // by the walks, on several threads
   std::vector<BlockSource> triangle_sources_, sphere_sources_;  // per block of out_.blocks, same order
@@ -498,8 +520,9 @@ class Flattener {
 
 }  // namespace
 
-Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count) {
-  return Flattener(tree, geometry, merge_leaves, thread_count).run();
+Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count,
+                  bool split_references) {
+  return Flattener(tree, geometry, merge_leaves, thread_count, split_references).run();
 }
 
 }  // namespace rtcl
