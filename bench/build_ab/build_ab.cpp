@@ -10,13 +10,14 @@
 // flatten into 8-wide nodes and blocks; the upload is not in it. Embree's is
 // EmbreeScene::build_ms: geometry setup and rtcCommitScene at
 // RTC_BUILD_QUALITY_MEDIUM (its default). One warm-up round per scene, then
-// ROUNDS rounds, the order of the two swapped each round. Prints per scene
+// ROUNDS rounds of one build each, the order rotated each round. Prints per scene
 // the fastest and median ms of each and their ratios (rtcl / Embree: < 1
 // means rtcl builds faster), then the medians of rtcl's phases (validate,
 // the binary build, the flatten).
 //
-// Environment: RTCL_SCENES_DIR; AB_PRESPLIT (the bvh's presplit option,
-// default 0).
+// Environment: RTCL_SCENES_DIR; AB_PRESPLIT: values of the bvh's presplit
+// option, comma-separated (default 0); with several, each is a version of
+// rtcl's build of its own row, all in every round, the order rotated.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -87,8 +88,16 @@ int run(int argc, char** argv) {
   const int rounds = parse_rounds(argv[2]);
   const std::string scenes_dir = scenes_dir_or(RTCL_BUILD_AB_SCENES_DIR);
   const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
-  BvhConfig config;  // the "bvh" structure's defaults: SAH on all hardware threads
-  if (const char* presplit = std::getenv("AB_PRESPLIT")) config.presplit = std::strtof(presplit, nullptr);
+  std::vector<BvhConfig> configs;  // the "bvh" structure's defaults (SAH on all hardware threads), presplit apart
+  const char* presplit_env = std::getenv("AB_PRESPLIT");
+  for (const std::string& value : split(presplit_env && *presplit_env ? presplit_env : "0")) {
+    BvhConfig config;
+    char* end = nullptr;
+    config.presplit = std::strtof(value.c_str(), &end);
+    if (end == value.c_str() || *end || !(config.presplit >= 0.0f))
+      throw Error("AB_PRESPLIT: '" + value + "' is not a number >= 0");
+    configs.push_back(config);
+  }
   for (const std::string& name : scenes)
     if (name.rfind("soup:", 0) != 0 && !find_scene_spec(name))
       throw Error("scene '" + name + "': neither a bench/ scene nor soup:N");
@@ -99,30 +108,33 @@ int run(int argc, char** argv) {
   std::printf("|---|--:|--:|--:|--:|\n");
   for (const std::string& name : scenes) {
     const Geometry geometry = load_scene(name, scenes_dir);
-    rtcl_build_ms(geometry, config);
+    for (const BvhConfig& config : configs) rtcl_build_ms(geometry, config);
     embree_build_ms(geometry, threads);
     std::vector<double> theirs;
-    std::vector<std::vector<double>> phases(4);
-    auto ours_once = [&] {
-      std::vector<double> p = rtcl_build_ms(geometry, config);
-      for (std::size_t k = 0; k < p.size(); ++k) phases[k].push_back(p[k]);
-    };
-    for (int round = 0; round < rounds; ++round) {
-      if (round % 2 == 0) {
-        ours_once();
-        theirs.push_back(embree_build_ms(geometry, threads));
-      } else {
-        theirs.push_back(embree_build_ms(geometry, threads));
-        ours_once();
+    // phases[v][k]: version v's phase k (rtcl_build_ms), one entry per round
+    std::vector<std::vector<std::vector<double>>> phases(configs.size(), std::vector<std::vector<double>>(4));
+    const std::size_t versions = configs.size() + 1;  // the last one is Embree
+    for (int round = 0; round < rounds; ++round)
+      for (std::size_t j = 0; j < versions; ++j) {
+        const std::size_t v = (j + static_cast<std::size_t>(round)) % versions;
+        if (v == configs.size()) {
+          theirs.push_back(embree_build_ms(geometry, threads));
+          continue;
+        }
+        std::vector<double> p = rtcl_build_ms(geometry, configs[v]);
+        for (std::size_t k = 0; k < p.size(); ++k) phases[v][k].push_back(p[k]);
       }
+    for (std::size_t v = 0; v < configs.size(); ++v) {
+      const std::vector<double>& ours = phases[v][0];
+      std::string label = name;
+      if (configs.size() > 1 || configs[v].presplit > 0.0f) label += " presplit=" + format_ms(configs[v].presplit);
+      std::printf("| %s | %zu | %.1f / %.1f | %.1f / %.1f | %.2f / %.2f |\n", label.c_str(),
+                  geometry.triangles.size(), fastest(ours), median(ours), fastest(theirs), median(theirs),
+                  fastest(ours) / fastest(theirs), median(ours) / median(theirs));
+      phase_lines.push_back(label + ": validate " + format_ms(median(phases[v][1])) + ", binary build " +
+                            format_ms(median(phases[v][2])) + ", flatten " + format_ms(median(phases[v][3])));
     }
-    const std::vector<double>& ours = phases[0];
-    std::printf("| %s | %zu | %.1f / %.1f | %.1f / %.1f | %.2f / %.2f |\n", name.c_str(), geometry.triangles.size(),
-                fastest(ours), median(ours), fastest(theirs), median(theirs), fastest(ours) / fastest(theirs),
-                median(ours) / median(theirs));
     std::fflush(stdout);
-    phase_lines.push_back(name + ": validate " + format_ms(median(phases[1])) + ", binary build " +
-                          format_ms(median(phases[2])) + ", flatten " + format_ms(median(phases[3])));
   }
   std::printf("\nrtcl's phases (medians, ms):\n");
   for (const std::string& line : phase_lines) std::printf("  %s\n", line.c_str());

@@ -48,30 +48,22 @@ std::size_t presplit_triangles(const Geometry& geometry, std::vector<std::uint32
   double area_sum = 0.0;
   for (std::size_t i = 0; i < triangle_refs; ++i) area_sum += bounds[i].area();
   const float threshold = static_cast<float>(factor * area_sum / static_cast<double>(triangle_refs));
-  std::size_t large = 0;
-  for (std::size_t i = 0; i < triangle_refs; ++i) large += bounds[i].area() > threshold;
-  if (large == 0) return triangle_refs;
 
+  // A split reference keeps its slot for its first part; the other parts
+  // follow the triangle references, in the order of their triangles.
   const std::size_t budget = kPresplitMaxGrowth * triangle_refs;
-  std::vector<std::uint32_t> out_ids;
-  std::vector<Aabb> out_bounds;
-  out_ids.reserve(triangle_refs + 2 * large);
-  out_bounds.reserve(triangle_refs + 2 * large);
+  std::vector<std::uint32_t> more_ids;
+  std::vector<Aabb> more_bounds;
   struct Part {
     Aabb box;
     int depth;
   };
   std::vector<Part> parts;
   for (std::size_t i = 0; i < triangle_refs; ++i) {
-    // Every reference not yet emitted still counts against the budget.
-    const std::size_t pending = triangle_refs - i - 1;
-    if (bounds[i].area() <= threshold || out_ids.size() + pending + 2 > budget) {
-      out_ids.push_back(ids[i]);
-      out_bounds.push_back(bounds[i]);
-      continue;
-    }
+    if (!(bounds[i].area() > threshold) || triangle_refs + more_ids.size() + 1 > budget) continue;
     const glm::uvec3& t = geometry.triangles[ids[i]];
     const glm::vec3 v[3] = {geometry.vertices[t.x], geometry.vertices[t.y], geometry.vertices[t.z]};
+    bool first = true;
     parts.assign(1, Part{bounds[i], 0});
     while (!parts.empty()) {
       const Part part = parts.back();
@@ -79,12 +71,19 @@ std::size_t presplit_triangles(const Geometry& geometry, std::vector<std::uint32
       const glm::vec3 extent = part.box.extent();
       const int axis = longest_axis(extent);
       const float plane = part.box.lower[axis] + 0.5f * extent[axis];
+      // The references if this part and the pending ones were kept (the
+      // first of them takes slot i), plus the one a split adds.
+      const std::size_t kept = triangle_refs + more_ids.size() + parts.size() + (first ? 0 : 1);
       const bool split = part.box.area() > threshold && part.depth < kPresplitMaxDepth &&
-                         plane > part.box.lower[axis] && plane < part.box.upper[axis] &&
-                         out_ids.size() + parts.size() + pending + 2 <= budget;
+                         plane > part.box.lower[axis] && plane < part.box.upper[axis] && kept + 1 <= budget;
       if (!split) {
-        out_ids.push_back(ids[i]);
-        out_bounds.push_back(part.box);
+        if (first) {
+          bounds[i] = part.box;
+          first = false;
+        } else {
+          more_ids.push_back(ids[i]);
+          more_bounds.push_back(part.box);
+        }
         continue;
       }
       const Aabb below = side_box(v, part.box, axis, plane, true);
@@ -96,12 +95,10 @@ std::size_t presplit_triangles(const Geometry& geometry, std::vector<std::uint32
       if (!below.empty() && !(below_flat && !above_flat)) parts.push_back({below, part.depth + 1});
     }
   }
-  const std::size_t triangle_out = out_ids.size();
-  out_ids.insert(out_ids.end(), ids.begin() + static_cast<std::ptrdiff_t>(triangle_refs), ids.end());
-  out_bounds.insert(out_bounds.end(), bounds.begin() + static_cast<std::ptrdiff_t>(triangle_refs), bounds.end());
-  ids = std::move(out_ids);
-  bounds = std::move(out_bounds);
-  return triangle_out;
+  const auto at = static_cast<std::ptrdiff_t>(triangle_refs);
+  ids.insert(ids.begin() + at, more_ids.begin(), more_ids.end());
+  bounds.insert(bounds.begin() + at, more_bounds.begin(), more_bounds.end());
+  return triangle_refs + more_ids.size();
 }
 
 }  // namespace rtcl

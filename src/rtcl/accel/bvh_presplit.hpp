@@ -17,8 +17,9 @@
 namespace rtcl {
 
 // ids[0, triangle_refs) are triangle ids of `geometry` and bounds[] their
-// boxes; the entries after them (spheres) are kept, behind the new triangle
-// references. Every triangle reference whose box's surface area exceeds
+// boxes; a split reference keeps its place for its first part, the other
+// parts are inserted after the triangle references, before the entries
+// that follow them (spheres). Every triangle reference whose box's surface area exceeds
 // `factor` times the mean over the triangle references is split at the
 // midpoint of its longest axis into the boxes of the triangle's parts on
 // either side (each within the box split), recursively, until a part's box
