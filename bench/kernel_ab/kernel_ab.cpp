@@ -59,7 +59,8 @@ using namespace rtcl::bench;
 
 int run(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: rtcl_kernel_ab SCENES ROUNDS KERNEL_DIR[#ACCEL_SPEC]...  (e.g. bunny,sponza 15 old/ kernels/)\n");
+    std::fprintf(stderr,
+                 "usage: rtcl_kernel_ab SCENES ROUNDS KERNEL_DIR[#ACCEL_SPEC]...  (e.g. bunny,sponza 15 old/ kernels/)\n");
     return 2;
   }
   const std::vector<std::string> scenes = split(argv[1]);

@@ -466,8 +466,8 @@ class Flattener {
   }
 
   [[noreturn]] void fail_outside(std::uint32_t leaf, std::uint32_t p) const {
-    fail("leaf " + std::to_string(leaf) + (split_references_ ? " does not meet primitive " : " does not contain primitive ") +
-         std::to_string(p));
+    const char* relation = split_references_ ? " does not meet primitive " : " does not contain primitive ";
+    fail("leaf " + std::to_string(leaf) + relation + std::to_string(p));
   }
 
   // Whether box and the box of triangle (a, b, c) share a point: a leaf
