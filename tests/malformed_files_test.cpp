@@ -171,13 +171,22 @@ TEST_F(MalformedFiles, EmptyFilesDirectoriesAndGarbage) {
 }
 
 // An OBJ whose MTL names itself, and an OBJ that names itself as its MTL:
-// both end quickly; their faces have no valid vertex, so the mesh is empty.
+// both end quickly, refused (their first statement, mtllib, comes before
+// any material).
 TEST_F(MalformedFiles, SelfReferencingMaterialFiles) {
   dir.write("loop.mtl", "mtllib loop.mtl\nnewmtl a\nKd 1 0 0\nmap_Kd loop.mtl\n");
   dir.write("loop.obj", "mtllib loop.mtl\nusemtl a\nf 1 2 3\n");
   expect_trace_rejects({"loop.obj", "loop.obj: "});
   dir.write("itself.obj", "mtllib itself.obj\nusemtl itself\nf 1 2 3\n");
   expect_trace_rejects({"itself.obj", "itself.obj: "});
+}
+
+// A material statement before the MTL file's first newmtl (a fuzzer's
+// input on which Assimp 5.2 crashed) is refused before Assimp reads it.
+TEST_F(MalformedFiles, MaterialStatementBeforeTheFirstMaterial) {
+  dir.write("early.mtl", "a 0.1 newmtl glass\n");
+  dir.write("early.obj", "mtllib early.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\n");
+  expect_trace_rejects({"early.obj", "early.mtl, line 1: 'a' comes before the first newmtl"});
 }
 
 TEST_F(MalformedFiles, SceneFileWhoseMeshIsADirectory) {

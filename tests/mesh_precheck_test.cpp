@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "support/error_of.hpp"
 
@@ -38,6 +39,23 @@ TEST(MeshPrecheck, MalformedFilesNameWhatTheyDeclare) {
   e = error_of([] { check_declared_sizes("a.stl", ".stl", std::string(83, 'x')); });
   EXPECT_NE(e.find("a.stl: 83 bytes: neither an ASCII STL"), std::string::npos) << e;
   EXPECT_NE(error_of([] { check_declared_sizes("a.obj", ".obj", ""); }).find("a.obj: the file is empty"),
+            std::string::npos);
+}
+
+TEST(MeshPrecheck, MaterialLibrariesAsAssimpNamesThem) {
+  EXPECT_EQ(obj_material_libraries("v 0 0 0\nmtllib a.mtl\r\n  mtllib   my file.mtl \t\nmtllib\n# mtllib c.mtl\n"),
+            (std::vector<std::string>{"a.mtl", "my file.mtl"}));
+  EXPECT_TRUE(obj_material_libraries("").empty());
+}
+
+// Comments and blank lines may precede the first material; a statement may
+// not (Assimp 5.2 wrote `a ...` there through a null material).
+TEST(MeshPrecheck, MaterialStatementsNeedAMaterial) {
+  EXPECT_EQ(error_of([] { check_mtl_statements("m.mtl", "# exported\n\n  \t\r\nnewmtl red\nKd 1 0 0\na 0.1\n"); }), "");
+  EXPECT_EQ(error_of([] { check_mtl_statements("m.mtl", ""); }), "");
+  EXPECT_EQ(error_of([] { check_mtl_statements("m.mtl", "\nKd 1 0 0\nnewmtl red\n"); }),
+            "m.mtl, line 2: 'Kd' comes before the first newmtl, so it belongs to no material");
+  EXPECT_NE(error_of([] { check_mtl_statements("m.mtl", "a 0.1 newmtl x"); }).find("line 1: 'a' comes before"),
             std::string::npos);
 }
 

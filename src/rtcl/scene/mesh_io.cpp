@@ -190,8 +190,7 @@ class MeshBuilder {
 
 // Notes on the two places where Assimp 5.2's OBJ importer departs from the
 // file (see mesh_io.hpp), found by a scan of the statement keywords.
-std::vector<std::string> obj_notes(const std::string& path) {
-  std::string text = read_file(path);
+std::vector<std::string> obj_notes(const std::string& path, const std::string& text) {
   std::vector<std::string> notes;
   std::unordered_set<std::string> names;  // o and g names seen so far
   std::string current_object, repeated;
@@ -237,11 +236,26 @@ std::vector<std::string> obj_notes(const std::string& path) {
   return notes;
 }
 
+// The material files of an OBJ (`text`) that exist, as Assimp finds them
+// (beside the OBJ), checked before Assimp reads them (mesh_precheck.hpp). A
+// missing one Assimp reports and skips.
+void check_material_files(const std::string& path, std::string_view text) {
+  for (const std::string& name : obj_material_libraries(text)) {
+    const fs::path mtl = fs::path(path).parent_path() / name;
+    std::error_code ec;
+    if (!fs::is_regular_file(mtl, ec)) continue;
+    check_mtl_statements(path + ": material file " + mtl.string(), read_file(mtl.string()));
+  }
+}
+
 }  // namespace
 
 LoadedMesh load_mesh(const std::string& path) {
   check_input_file(path);
   check_sizes(path);
+  const bool obj = lower_extension(path) == ".obj";
+  const std::string obj_text = obj ? read_file(path) : std::string();
+  if (obj) check_material_files(path, obj_text);
   Assimp::Importer importer;
   const aiScene* scene = nullptr;
   try {
@@ -280,7 +294,7 @@ LoadedMesh load_mesh(const std::string& path) {
       stack.push_back({node.mChildren[i], top.transform * node.mChildren[i]->mTransformation});
   }
   LoadedMesh mesh = builder.finish();
-  if (lower_extension(path) == ".obj") mesh.notes = obj_notes(path);
+  if (obj) mesh.notes = obj_notes(path, obj_text);
   if (mesh.geometry.triangles.empty())
     throw Error(path + ": no triangles (" + std::to_string(faces) + " faces, none with three or more vertices)");
   return mesh;

@@ -244,6 +244,36 @@ void check_stl(const std::string& path, std::string_view bytes) {
 
 }  // namespace
 
+std::vector<std::string> obj_material_libraries(std::string_view text) {
+  std::vector<std::string> names;
+  for (std::size_t pos = 0; pos < text.size();) {
+    std::size_t end = std::min(text.find('\n', pos), text.size());
+    std::vector<std::string_view> w = words(text.substr(pos, end - pos));
+    if (!w.empty() && w[0] == "mtllib" && w.size() > 1) {
+      const char* first = w[1].data();
+      const char* last = w.back().data() + w.back().size();
+      names.emplace_back(first, static_cast<std::size_t>(last - first));
+    }
+    pos = end + 1;
+  }
+  return names;
+}
+
+void check_mtl_statements(const std::string& what, std::string_view bytes) {
+  std::size_t line = 0;
+  for (std::size_t pos = 0; pos < bytes.size();) {
+    std::size_t end = std::min(bytes.find('\n', pos), bytes.size());
+    ++line;
+    std::vector<std::string_view> w = words(bytes.substr(pos, end - pos));
+    if (!w.empty() && w[0][0] != '#') {
+      if (w[0] == "newmtl") return;
+      throw Error(what + ", line " + std::to_string(line) + ": '" + std::string(w[0].substr(0, 32)) +
+                  "' comes before the first newmtl, so it belongs to no material");
+    }
+    pos = end + 1;
+  }
+}
+
 void check_declared_sizes(const std::string& path, const std::string& extension, std::string_view bytes) {
   if (bytes.empty()) throw Error(path + ": the file is empty");
   if (extension == ".ply") check_ply(path, bytes);

@@ -7,6 +7,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace rtcl {
 
@@ -21,5 +22,16 @@ namespace rtcl {
 //   84 + 50 * triangle_count bytes its header declares.
 // `extension` is lower case with its dot (".ply").
 void check_declared_sizes(const std::string& path, const std::string& extension, std::string_view bytes);
+
+// The material files an OBJ names (`text`: the whole OBJ), as Assimp 5.2
+// reads them: the rest of each mtllib line, without surrounding blanks.
+std::vector<std::string> obj_material_libraries(std::string_view text);
+
+// Throws Error naming `what` and the line when an MTL file (`bytes`: the
+// whole file) has a statement other than a comment before its first
+// newmtl: it belongs to no material, and Assimp 5.2 writes some such
+// statements through a null material (`a 0.1 newmtl x` crashed it; found
+// by fuzzing).
+void check_mtl_statements(const std::string& what, std::string_view bytes);
 
 }  // namespace rtcl
