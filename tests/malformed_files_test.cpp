@@ -187,6 +187,10 @@ TEST_F(MalformedFiles, MaterialStatementBeforeTheFirstMaterial) {
   dir.write("early.mtl", "a 0.1 newmtl glass\n");
   dir.write("early.obj", "mtllib early.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\n");
   expect_trace_rejects({"early.obj", "early.mtl, line 1: 'a' comes before the first newmtl"});
+  // A material file that is not there: Assimp reads the OBJ's name with .mtl.
+  dir.write("fallback.mtl", "\nKd 1 0 0\nnewmtl glass\n");
+  dir.write("fallback.obj", "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl glass\nf 1 2 3\n");
+  expect_trace_rejects({"fallback.obj", "fallback.mtl, line 2: 'Kd' comes before the first newmtl"});
 }
 
 TEST_F(MalformedFiles, SceneFileWhoseMeshIsADirectory) {

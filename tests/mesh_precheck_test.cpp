@@ -44,7 +44,7 @@ TEST(MeshPrecheck, MalformedFilesNameWhatTheyDeclare) {
 
 TEST(MeshPrecheck, MaterialLibrariesAsAssimpNamesThem) {
   EXPECT_EQ(obj_material_libraries("v 0 0 0\nmtllib a.mtl\r\n  mtllib   my file.mtl \t\nmtllib\n# mtllib c.mtl\n"),
-            (std::vector<std::string>{"a.mtl", "my file.mtl"}));
+            (std::vector<std::string>{"a.mtl", "my file.mtl", ""}));
   EXPECT_TRUE(obj_material_libraries("").empty());
 }
 

@@ -236,15 +236,18 @@ std::vector<std::string> obj_notes(const std::string& path, const std::string& t
   return notes;
 }
 
-// The material files of an OBJ (`text`) that exist, as Assimp finds them
-// (beside the OBJ), checked before Assimp reads them (mesh_precheck.hpp). A
-// missing one Assimp reports and skips.
+// The material files of an OBJ (`text`) as Assimp 5.2 finds them, checked
+// before Assimp reads them (mesh_precheck.hpp): each mtllib name beside the
+// OBJ, or where there is no such file, the OBJ's own name with "mtl" for
+// its last three characters (Assimp's fallback); neither: Assimp reports it
+// and reads no material.
 void check_material_files(const std::string& path, std::string_view text) {
-  for (const std::string& name : obj_material_libraries(text)) {
-    const fs::path mtl = fs::path(path).parent_path() / name;
+  for (std::string name : obj_material_libraries(text)) {
+    name.resize(std::min(name.find('\0'), name.size()));  // a C string to Assimp's file system
     std::error_code ec;
-    if (!fs::is_regular_file(mtl, ec)) continue;
-    check_mtl_statements(path + ": material file " + mtl.string(), read_file(mtl.string()));
+    std::string mtl = (fs::path(path).parent_path() / name).string();
+    if (name.empty() || !fs::is_regular_file(mtl, ec)) mtl = path.substr(0, path.size() - 3) + "mtl";
+    if (fs::is_regular_file(mtl, ec)) check_mtl_statements(path + ": material file " + mtl, read_file(mtl));
   }
 }
 

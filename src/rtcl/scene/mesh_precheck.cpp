@@ -249,8 +249,8 @@ std::vector<std::string> obj_material_libraries(std::string_view text) {
   for (std::size_t pos = 0; pos < text.size();) {
     std::size_t end = std::min(text.find('\n', pos), text.size());
     std::vector<std::string_view> w = words(text.substr(pos, end - pos));
-    if (!w.empty() && w[0] == "mtllib" && w.size() > 1) {
-      const char* first = w[1].data();
+    if (!w.empty() && w[0] == "mtllib") {
+      const char* first = w.size() > 1 ? w[1].data() : w[0].data() + w[0].size();
       const char* last = w.back().data() + w.back().size();
       names.emplace_back(first, static_cast<std::size_t>(last - first));
     }

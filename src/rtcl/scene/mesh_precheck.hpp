@@ -24,7 +24,8 @@ namespace rtcl {
 void check_declared_sizes(const std::string& path, const std::string& extension, std::string_view bytes);
 
 // The material files an OBJ names (`text`: the whole OBJ), as Assimp 5.2
-// reads them: the rest of each mtllib line, without surrounding blanks.
+// reads them: the rest of each mtllib line, without surrounding blanks
+// (empty for a bare mtllib).
 std::vector<std::string> obj_material_libraries(std::string_view text);
 
 // Throws Error naming `what` and the line when an MTL file (`bytes`: the
