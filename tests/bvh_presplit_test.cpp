@@ -6,13 +6,13 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <random>
 #include <vector>
 
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/bvh_presplit.hpp"
 #include "rtcl/error.hpp"
+#include "support/everywhere.hpp"
 #include "support/fixtures.hpp"
 
 namespace rtcl::test {
@@ -49,11 +49,6 @@ References triangle_references(const Geometry& g) {
   return r;
 }
 
-bool in_box(const Aabb& box, const glm::vec3& p) { return box.contains(p); }
-
-Ray ray(glm::vec3 o, glm::vec3 d) {
-  return Ray{o.x, o.y, o.z, d.x, d.y, d.z, 0.0f, std::numeric_limits<float>::infinity()};
-}
 
 TEST(Presplit, PartsCoverTheirTriangleWithinItsBox) {
   Geometry g = soup_with_large_triangles(400, 3);
@@ -82,7 +77,7 @@ TEST(Presplit, PartsCoverTheirTriangleWithinItsBox) {
       for (int j = 0; i + j <= kSteps; ++j) {
         const double u = double(i) / kSteps, v = double(j) / kSteps;
         const glm::vec3 point(a + u * (b - a) + v * (c - a));
-        EXPECT_TRUE(std::any_of(parts.begin(), parts.end(), [&](const Aabb& box) { return in_box(box, point); }))
+        EXPECT_TRUE(std::any_of(parts.begin(), parts.end(), [&](const Aabb& box) { return box.contains(point); }))
             << "large triangle " << p << " at (" << u << ", " << v << ")";
       }
   }
@@ -143,16 +138,16 @@ TEST(Presplit, AnswersAsBruteForceAlsoAlongSplitPlanes) {
   for (int i = -8; i <= 16; ++i)
     for (int k = -8; k <= 16; ++k) {
       const float x = i / 8.0f, z = k / 8.0f;
-      rays.push_back(ray({x, 3, z}, {0, -1, 0}));
-      rays.push_back(ray({x, 3, z}, {-0.0f, -1, 0.0f}));
-      rays.push_back(ray({x, -0.5f, z}, {0.25f, 1, 0}));
+      rays.push_back(everywhere::make_ray({x, 3, z}, {0, -1, 0}));
+      rays.push_back(everywhere::make_ray({x, 3, z}, {-0.0f, -1, 0.0f}));
+      rays.push_back(everywhere::make_ray({x, -0.5f, z}, {0.25f, 1, 0}));
     }
   // In the plane x = 0.5 and z = 0.5, along the floor's surface and across it.
   for (int k = -16; k <= 32; ++k) {
     const float s = k / 16.0f;
-    rays.push_back(ray({0.5f, 1, s}, {0, -1, 0.001f}));
-    rays.push_back(ray({s, 1, 0.5f}, {0.001f, -1, 0}));
-    rays.push_back(ray({-2, 0, s}, {1, 0, 0}));
+    rays.push_back(everywhere::make_ray({0.5f, 1, s}, {0, -1, 0.001f}));
+    rays.push_back(everywhere::make_ray({s, 1, 0.5f}, {0.001f, -1, 0}));
+    rays.push_back(everywhere::make_ray({-2, 0, s}, {1, 0, 0}));
   }
   const Device& device = test_device();
   auto brute = make_accel(device, "brute", g);

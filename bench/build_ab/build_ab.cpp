@@ -63,7 +63,7 @@ std::vector<double> rtcl_build_ms(const Geometry& geometry, const BvhConfig& con
   const Clock::time_point validated = Clock::now();
   BuildTree tree = build_binary_bvh(geometry, config);
   const Clock::time_point built = Clock::now();
-  Bvh8 bvh = flatten_bvh8(tree, geometry, config.merge_leaves, bvh_thread_count(config), config.presplit > 0.0f);
+  Bvh8 bvh = flatten_bvh8(tree, geometry, config);
   const Clock::time_point flattened = Clock::now();
   if (bvh.nodes.empty()) throw Error("empty BVH");
   return {ms(start, flattened), ms(start, validated), ms(validated, built), ms(built, flattened)};
@@ -127,7 +127,11 @@ int run(int argc, char** argv) {
     for (std::size_t v = 0; v < configs.size(); ++v) {
       const std::vector<double>& ours = phases[v][0];
       std::string label = name;
-      if (configs.size() > 1 || configs[v].presplit > 0.0f) label += " presplit=" + format_ms(configs[v].presplit);
+      if (configs.size() > 1 || configs[v].presplit > 0.0f) {
+        char option[32];
+        std::snprintf(option, sizeof option, " presplit=%g", configs[v].presplit);
+        label += option;
+      }
       std::printf("| %s | %zu | %.1f / %.1f | %.1f / %.1f | %.2f / %.2f |\n", label.c_str(),
                   geometry.triangles.size(), fastest(ours), median(ours), fastest(theirs), median(theirs),
                   fastest(ours) / fastest(theirs), median(ours) / median(theirs));

@@ -10,8 +10,9 @@
 // the same way as kernels (their hits may then differ in ties).
 //
 // Each KERNEL_DIR is a copy of kernels/ (RTCL_KERNEL_DIR is set to it while
-// its structure's programs are built; programs are cached by source, so the
-// versions never share one). Per scene (bench/ camera and light, image side
+// its structure's programs are built; programs are cached by source, so
+// versions of different directories never share one, versions of one
+// directory do). Per scene (bench/ camera and light, image side
 // $RTCL_BENCH_RES, default 512) it traces the primary rays and the shadow and
 // diffuse rays spawned from the first version's primary hits, as bench/
 // does. Per ray set: one launch per version whose hits are compared with the

@@ -103,6 +103,10 @@ unsigned bvh_thread_count(const BvhConfig& config) {
   return config.builder == BvhBuilder::ploc ? config.ploc.thread_count : config.sah.thread_count;
 }
 
+Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, const BvhConfig& config) {
+  return flatten_bvh8(tree, geometry, config.merge_leaves, bvh_thread_count(config), config.presplit > 0.0f);
+}
+
 std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size) { return std::max(8u, (stack_size + 7u) / 8u * 8u); }
 
 AccelStats bvh_stats(const Geometry& geometry, const GeometryReport& report, const Bvh8& bvh,
@@ -130,7 +134,7 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
   std::size_t stored = 0;
   BuildTree tree = build_binary_bvh(geometry, config, &stored);
   report.zero_area_triangles = geometry.primitive_count() - stored;
-  Bvh8 bvh = flatten_bvh8(tree, geometry, config.merge_leaves, bvh_thread_count(config), config.presplit > 0.0f);
+  Bvh8 bvh = flatten_bvh8(tree, geometry, config);
   AccelStats stats = bvh_stats(geometry, report, bvh, start);
   std::vector<std::string> defines = bvh_defines(geometry, bvh);
   return std::make_unique<BvhAccel>(device, std::move(name), config.traversal, std::move(defines), bvh, stats,

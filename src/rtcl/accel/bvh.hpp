@@ -93,6 +93,10 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config = {
 Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves = true,
                   unsigned thread_count = 0, bool split_references = false);
 
+// The flatten of a tree built by build_binary_bvh(geometry, config): the
+// config's merge_leaves and threads, split references where it presplits.
+Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, const BvhConfig& config);
+
 // The threads the config's builder may use (its thread_count).
 unsigned bvh_thread_count(const BvhConfig& config);
 

@@ -1,6 +1,5 @@
 #include "rtcl/accel/bvh_presplit.hpp"
 
-#include <algorithm>
 #include <cfloat>
 #include <cmath>
 

@@ -17,15 +17,15 @@
 namespace rtcl {
 
 // ids[0, triangle_refs) are triangle ids of `geometry` and bounds[] their
-// boxes; a split reference keeps its place for its first part, the other
-// parts are inserted after the triangle references, before the entries
-// that follow them (spheres). Every triangle reference whose box's surface area exceeds
-// `factor` times the mean over the triangle references is split at the
-// midpoint of its longest axis into the boxes of the triangle's parts on
-// either side (each within the box split), recursively, until a part's box
-// is at most that area, at most kPresplitMaxDepth times per triangle, and
-// while the references number at most kPresplitMaxGrowth times the
-// triangles. The parts' boxes together contain the whole triangle (the
+// boxes. Every triangle reference whose box's surface area exceeds `factor`
+// times the mean over the triangle references is split at the midpoint of
+// its longest axis into the boxes of the triangle's parts on either side
+// (each within the box split), recursively, until a part's box is at most
+// that area, at most kPresplitMaxDepth times per triangle, and while the
+// references number at most kPresplitMaxGrowth times the triangles. A split
+// reference keeps its place for its first part; the other parts are
+// inserted after the triangle references, before the entries that follow
+// them (spheres). The parts' boxes together contain the whole triangle (the
 // clipped vertices are widened by a few ulps). factor <= 0: no change.
 // Returns the new number of triangle references. Deterministic.
 std::size_t presplit_triangles(const Geometry& geometry, std::vector<std::uint32_t>& ids, std::vector<Aabb>& bounds,
