@@ -369,6 +369,28 @@ TEST(Bvh, ZeroAreaTrianglesInEveryPartAreSkipped) {
   EXPECT_EQ(check_wide(flatten_bvh8(tree, g), g), "");
 }
 
+// A caller's builder replaces the SAH for each kind of primitive (200
+// spheres, 2000 triangles here); its tree is
+// traced like the SAH's, and one missing a primitive is refused.
+TEST(Bvh, CustomBuilderTreesAreTracedAndChecked) {
+  Geometry g = soup_with_spheres(2000, 200, 21);
+  std::vector<std::size_t> calls;
+  BvhConfig config;
+  config.custom_builder = [&calls](std::span<const Aabb> bounds, std::span<const std::uint32_t> ids) {
+    calls.push_back(ids.size());
+    return build_ploc(bounds, ids);
+  };
+  auto accel = make_bvh(test_device(), g, config);
+  std::sort(calls.begin(), calls.end());  // one call per kind, in either order
+  EXPECT_EQ(calls, (std::vector<std::size_t>{g.spheres.size(), g.triangles.size()}));
+  expect_matches_reference(*accel, g, random_rays(g, 1000, 23));
+
+  config.custom_builder = [](std::span<const Aabb> bounds, std::span<const std::uint32_t> ids) {
+    return build_sah(bounds.first(bounds.size() - 1), ids.first(ids.size() - 1));
+  };
+  EXPECT_THROW(make_bvh(test_device(), g, config), Error);
+}
+
 TEST(Bvh, MatchesReferenceOnBunny) { expect_real_mesh_matches("stanford_bunny/bunny.obj"); }
 TEST(Bvh, MatchesReferenceOnDragon) { expect_real_mesh_matches("stanford_dragon_100k/dragon.obj"); }
 TEST(Bvh, MatchesReferenceOnSponza) { expect_real_mesh_matches("sponza/sponza.obj"); }

@@ -7,7 +7,10 @@
 //
 // A version's ACCEL_SPEC (default $AB_ACCEL, else bvh) is the structure and
 // its build options as `--accel` takes them, so build options are compared
-// the same way as kernels (their hits may then differ in ties).
+// the same way as kernels (their hits may then differ in ties). The spec
+// `embree-tree` is the bvh over Embree's binary SAH tree (rtcBuildBVH,
+// embree_baseline.hpp) instead of rtcl's: the same flatten and kernels, so
+// the two builders' trees are compared as traced.
 //
 // Each KERNEL_DIR is a copy of kernels/ (RTCL_KERNEL_DIR is set to it while
 // its structure's programs are built; programs are cached by source, so
@@ -42,6 +45,7 @@
 #include <vector>
 
 #include "rtcl/accel/accel.hpp"
+#include "rtcl/accel/bvh.hpp"
 #include "rtcl/bench/ray_sets.hpp"
 #include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/cl/device.hpp"
@@ -101,7 +105,19 @@ int run(int argc, char** argv) {
     std::vector<std::unique_ptr<Accel>> accels;
     for (const Version& version : versions) {
       setenv("RTCL_KERNEL_DIR", version.kernel_dir.c_str(), 1);
-      accels.push_back(make_accel(device, version.accel_spec, geometry));
+      if (version.accel_spec == "embree-tree") {
+#ifdef RTCL_HAVE_EMBREE
+        BvhConfig config;
+        config.custom_builder = [threads](std::span<const Aabb> bounds, std::span<const std::uint32_t> ids) {
+          return embree_binary_tree(bounds, ids, threads);
+        };
+        accels.push_back(make_bvh(device, geometry, config));
+#else
+        throw Error("version spec 'embree-tree': rtcl_kernel_ab was built without Embree");
+#endif
+      } else {
+        accels.push_back(make_accel(device, version.accel_spec, geometry));
+      }
     }
     // One launch of version v over `rays`; its hits into *hits when given.
     auto launch = [&](std::size_t v, Query query, const std::vector<Ray>& rays, std::vector<Hit>* hits) {

@@ -25,6 +25,8 @@ Aabb sphere_bounds(const Sphere& s) {
 }
 
 BuildTree build_kind(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const BvhConfig& config) {
+  if (bounds.empty()) return {};
+  if (config.custom_builder) return config.custom_builder(bounds, ids);
   return config.builder == BvhBuilder::ploc ? build_ploc(bounds, ids, config.ploc) : build_sah(bounds, ids, config.sah);
 }
 

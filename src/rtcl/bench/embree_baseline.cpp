@@ -268,6 +268,115 @@ void EmbreeScene::trace(Query query, const Ray* rays, Hit* hits, std::size_t cou
   prepared_.reset();
 }
 
+namespace {
+
+// rtcBuildBVH's records, in its thread-local allocators: an inner node's
+// two children with their boxes, or a leaf's indices into the bounds.
+struct EmbreeBuildNode {
+  bool leaf;
+  unsigned count;
+  RTCBounds box[2];
+  const EmbreeBuildNode* child[2];
+  unsigned prim[RTCL_BLOCK_WIDTH];
+};
+
+EmbreeBuildNode* new_build_node(RTCThreadLocalAllocator alloc) {
+  return static_cast<EmbreeBuildNode*>(rtcThreadLocalAlloc(alloc, sizeof(EmbreeBuildNode), alignof(EmbreeBuildNode)));
+}
+
+void* create_build_node(RTCThreadLocalAllocator alloc, unsigned, void*) {
+  EmbreeBuildNode* node = new_build_node(alloc);
+  if (node) *node = EmbreeBuildNode{false, 0, {}, {}, {}};
+  return node;
+}
+
+void set_build_children(void* node, void** children, unsigned count, void*) {
+  auto* n = static_cast<EmbreeBuildNode*>(node);
+  n->count = std::min(count, 2u);
+  for (unsigned i = 0; i < n->count; ++i) n->child[i] = static_cast<const EmbreeBuildNode*>(children[i]);
+}
+
+void set_build_bounds(void* node, const RTCBounds** bounds, unsigned count, void*) {
+  auto* n = static_cast<EmbreeBuildNode*>(node);
+  for (unsigned i = 0; i < std::min(count, 2u); ++i) n->box[i] = *bounds[i];
+}
+
+void* create_build_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, std::size_t count, void*) {
+  EmbreeBuildNode* leaf = new_build_node(alloc);
+  if (!leaf || count > RTCL_BLOCK_WIDTH) return nullptr;
+  *leaf = EmbreeBuildNode{true, static_cast<unsigned>(count), {}, {}, {}};
+  for (std::size_t i = 0; i < count; ++i) leaf->prim[i] = prims[i].primID;
+  return leaf;
+}
+
+Aabb to_aabb(const RTCBounds& b) { return {{b.lower_x, b.lower_y, b.lower_z}, {b.upper_x, b.upper_y, b.upper_z}}; }
+
+// Appends the subtree of `node` (box `box`) to `tree`; returns its index.
+std::uint32_t append_build_node(const EmbreeBuildNode* node, const Aabb& box, std::span<const std::uint32_t> ids,
+                                BuildTree& tree) {
+  if (!node || (!node->leaf && node->count != 2)) throw Error("Embree: rtcBuildBVH returned an incomplete tree");
+  auto index = static_cast<std::uint32_t>(tree.nodes.size());
+  tree.nodes.emplace_back();
+  tree.nodes[index].bounds = box;
+  if (node->leaf) {
+    tree.nodes[index].first = static_cast<std::uint32_t>(tree.prims.size());
+    tree.nodes[index].count = node->count;
+    for (unsigned i = 0; i < node->count; ++i) tree.prims.push_back(ids[node->prim[i]]);
+    return index;
+  }
+  std::uint32_t left = append_build_node(node->child[0], to_aabb(node->box[0]), ids, tree);
+  std::uint32_t right = append_build_node(node->child[1], to_aabb(node->box[1]), ids, tree);
+  tree.nodes[index].child[0] = left;
+  tree.nodes[index].child[1] = right;
+  return index;
+}
+
+}  // namespace
+
+BuildTree embree_binary_tree(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, unsigned threads) {
+  check_builder_input(bounds, ids, "embree");
+  if (bounds.empty()) return {};
+  RTCDevice device = embree_device(threads);
+  std::vector<RTCBuildPrimitive> prims(bounds.size());
+  Aabb all = bounds[0];
+  for (std::size_t i = 0; i < bounds.size(); ++i) {
+    const Aabb& b = bounds[i];
+    prims[i] = {b.lower.x, b.lower.y, b.lower.z, 0u, b.upper.x, b.upper.y, b.upper.z, static_cast<unsigned>(i)};
+    all.lower = glm::min(all.lower, b.lower);
+    all.upper = glm::max(all.upper, b.upper);
+  }
+  RTCBVH bvh = rtcNewBVH(device);
+  check_embree(device, "rtcNewBVH");
+  RTCBuildArguments args = rtcDefaultBuildArguments();
+  args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
+  args.maxBranchingFactor = 2;
+  args.maxDepth = 1024;
+  args.sahBlockSize = RTCL_BLOCK_WIDTH;
+  args.minLeafSize = 1;
+  args.maxLeafSize = RTCL_BLOCK_WIDTH;
+  args.traversalCost = 0.5f;
+  args.intersectionCost = 1.0f;
+  args.bvh = bvh;
+  args.primitives = prims.data();
+  args.primitiveCount = prims.size();
+  args.primitiveArrayCapacity = prims.size();
+  args.createNode = create_build_node;
+  args.setNodeChildren = set_build_children;
+  args.setNodeBounds = set_build_bounds;
+  args.createLeaf = create_build_leaf;
+  const auto* root = static_cast<const EmbreeBuildNode*>(rtcBuildBVH(&args));
+  BuildTree tree;
+  try {
+    check_embree(device, "rtcBuildBVH");
+    append_build_node(root, all, ids, tree);
+  } catch (...) {
+    rtcReleaseBVH(bvh);
+    throw;
+  }
+  rtcReleaseBVH(bvh);
+  return tree;
+}
+
 std::string embree_version(unsigned threads) {
   RTCDevice device = embree_device(threads);
   return std::to_string(rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_VERSION_MAJOR)) + "." +

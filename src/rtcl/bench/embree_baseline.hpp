@@ -7,10 +7,13 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "rtcl/accel/accel.hpp"
+#include "rtcl/accel/build_tree.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/scene/geometry.hpp"
 
@@ -74,6 +77,13 @@ class EmbreeScene {
   double build_ms_ = 0.0;
   std::size_t bytes_ = 0;
 };
+
+// Embree's binned SAH builder (rtcBuildBVH at RTC_BUILD_QUALITY_MEDIUM, the
+// builder behind its default scene build) as a BvhConfig::custom_builder:
+// a binary tree over bounds[i] / ids[i] with leaves of 1..8 primitives,
+// costed as rtcl's SAH is (a node 0.5, a block of up to eight primitives
+// 1), built on the process's Embree device. Throws Error when Embree fails.
+BuildTree embree_binary_tree(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, unsigned threads);
 
 // The library version, e.g. "3.13.5" (opens the Embree device with
 // `threads` if no scene did).
