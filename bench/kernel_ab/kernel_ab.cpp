@@ -31,7 +31,8 @@
 // shared, drifting machines their ratios hold where separate runs' do not.
 //
 // Environment: AB_ACCEL (structure, default bvh), AB_NO_EMBREE (set: no
-// Embree), RTCL_BENCH_RES, RTCL_SCENES_DIR, RTCL_DEVICE.
+// Embree), AB_SETS (the ray sets to time, e.g. "primary,shadow"; default
+// all three), RTCL_BENCH_RES, RTCL_SCENES_DIR, RTCL_DEVICE.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -89,6 +90,12 @@ int run(int argc, char** argv) {
   if (res < 1) throw Error("RTCL_BENCH_RES must be a positive number");
   const std::string scenes_dir = scenes_dir_or(RTCL_KERNEL_AB_SCENES_DIR);
   const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  const char* sets_env = std::getenv("AB_SETS");
+  const std::vector<std::string> timed_sets =
+      split(sets_env && *sets_env ? sets_env : "primary,shadow,diffuse");
+  for (const std::string& name : timed_sets)
+    if (name != "primary" && name != "shadow" && name != "diffuse")
+      throw Error("AB_SETS: unknown ray set '" + name + "' (known: primary, shadow, diffuse)");
 #ifdef RTCL_HAVE_EMBREE
   const bool use_embree = std::getenv("AB_NO_EMBREE") == nullptr;
 #endif
@@ -146,6 +153,7 @@ int run(int argc, char** argv) {
     if (use_embree) embree = std::make_unique<EmbreeScene>(geometry, EmbreeQuality::standard, threads);
 #endif
     for (const Set& set : sets) {
+      if (std::find(timed_sets.begin(), timed_sets.end(), set.name) == timed_sets.end()) continue;
       const std::vector<Ray>& rays = *set.rays;
       std::vector<Hit> first, other;
       launch(0, set.query, rays, &first);
