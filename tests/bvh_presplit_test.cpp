@@ -49,7 +49,6 @@ References triangle_references(const Geometry& g) {
   return r;
 }
 
-
 TEST(Presplit, PartsCoverTheirTriangleWithinItsBox) {
   Geometry g = soup_with_large_triangles(400, 3);
   References r = triangle_references(g);

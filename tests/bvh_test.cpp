@@ -370,8 +370,8 @@ TEST(Bvh, ZeroAreaTrianglesInEveryPartAreSkipped) {
 }
 
 // A caller's builder replaces the SAH for each kind of primitive (200
-// spheres, 2000 triangles here); its tree is
-// traced like the SAH's, and one missing a primitive is refused.
+// spheres, 2000 triangles here); its tree is traced like the SAH's, and one
+// missing a primitive is refused.
 TEST(Bvh, CustomBuilderTreesAreTracedAndChecked) {
   Geometry g = soup_with_spheres(2000, 200, 21);
   std::vector<std::size_t> calls;

@@ -58,11 +58,12 @@ struct BvhConfig {
   // 0.97-0.99x, built sponza in 3-13% more time, and split no triangle of
   // the bunny or the dragon.
   float presplit = 0.0f;
-  // A binary builder of the caller's in place of `builder`: given the boxes
-  // and ids of one kind of primitive (triangles, then spheres), a tree over
-  // exactly those ids with leaves of 1..8 (the flatten checks it and throws
-  // Error otherwise). For comparing builders on the same kernels: bench/
-  // kernel_ab traces Embree's binned SAH tree (embree_baseline.hpp) this way.
+  // A binary builder of the caller's in place of `builder`: called once per
+  // kind of primitive the geometry has (triangles, spheres; never with
+  // none) with their boxes and ids, it returns a tree over exactly those ids
+  // with leaves of 1..8 (the flatten checks it and throws Error otherwise).
+  // For comparing builders on the same kernels: bench/kernel_ab traces
+  // Embree's binned SAH tree (embree_baseline.hpp) this way.
   std::function<BuildTree(std::span<const Aabb>, std::span<const std::uint32_t>)> custom_builder;
 };
 

@@ -342,8 +342,7 @@ BuildTree embree_binary_tree(std::span<const Aabb> bounds, std::span<const std::
   for (std::size_t i = 0; i < bounds.size(); ++i) {
     const Aabb& b = bounds[i];
     prims[i] = {b.lower.x, b.lower.y, b.lower.z, 0u, b.upper.x, b.upper.y, b.upper.z, static_cast<unsigned>(i)};
-    all.lower = glm::min(all.lower, b.lower);
-    all.upper = glm::max(all.upper, b.upper);
+    all.grow(b);
   }
   RTCBVH bvh = rtcNewBVH(device);
   check_embree(device, "rtcNewBVH");
