@@ -14,6 +14,8 @@
 namespace rtcl::test {
 namespace {
 
+using namespace std::string_literals;
+
 const std::string header =
     "ply\r\nformat ascii 1.0\ncomment c\nobj_info o\nelement vertex 3\nproperty float x\nproperty float y\n"
     "property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
@@ -22,7 +24,8 @@ TEST(MeshPrecheck, TightWellFormedFilesPass) {
   // single digits and no final newline: the fewest bytes an ASCII body can have
   EXPECT_EQ(error_of([] { check_declared_sizes("a.ply", ".ply", header + "0 0 0 1 0 0 0 1 0 3 0 1 2"); }), "");
   std::string stl(80, 's');  // a binary header may start with anything but "solid"
-  stl += std::string("\x01\x00\x00\x00", 4) + std::string(50, '\0');
+  stl += "\x01\x00\x00\x00"s;
+  stl.append(50, '\0');
   EXPECT_EQ(error_of([&] { check_declared_sizes("a.stl", ".stl", stl); }), "");
   EXPECT_EQ(error_of([] { check_declared_sizes("a.stl", ".stl", "  solid x\nendsolid x\n"); }), "");
   EXPECT_EQ(error_of([] { check_declared_sizes("a.obj", ".obj", "v"); }), "");
@@ -43,9 +46,14 @@ TEST(MeshPrecheck, MalformedFilesNameWhatTheyDeclare) {
 }
 
 TEST(MeshPrecheck, MaterialLibrariesAsAssimpNamesThem) {
-  EXPECT_EQ(obj_material_libraries("v 0 0 0\nmtllib a.mtl\r\n  mtllib   my file.mtl \t\nmtllib\n# mtllib c.mtl\n"),
-            (std::vector<std::string>{"a.mtl", "my file.mtl", ""}));
+  EXPECT_EQ(obj_material_libraries("v 0 0 0\nmtllib a.mtl\r\nmtllib\t my file.mtl \t\nmtllib\n# mtllib c.mtl\n"
+                                   "  mtllib indented.mtl\nmtllibx x.mtl\n"),
+            (std::vector<std::string>{"a.mtl", "my file.mtl \t"}));
   EXPECT_TRUE(obj_material_libraries("").empty());
+  // NUL and form feed end lines; a backslash before a line end joins the
+  // text after the next newline, also at the end of the file
+  EXPECT_EQ(obj_material_libraries(",o \0mtllib \x01\0x\fmtllib f.mtl\nmtl\\\r\nlib j.mtl\nmtllib e\\"s),
+            (std::vector<std::string>{"\x01", "f.mtl", "j.mtl", "e"}));
 }
 
 // Comments and blank lines may precede the first material; a statement may
@@ -57,6 +65,9 @@ TEST(MeshPrecheck, MaterialStatementsNeedAMaterial) {
             "m.mtl, line 2: 'Kd' comes before the first newmtl, so it belongs to no material");
   EXPECT_NE(error_of([] { check_mtl_statements("m.mtl", "a 0.1 newmtl x"); }).find("line 1: 'a' comes before"),
             std::string::npos);
+  EXPECT_EQ(error_of([] { check_mtl_statements("m.mtl", "\xEF\xBB\xBFnewmtl red\nKd 1 0 0\n"); }), "");
+  EXPECT_EQ(error_of([] { check_mtl_statements("m.mtl", "# c\r\n# d\0Kd 1 0 0\nnewmtl red\n"s); }),
+            "m.mtl, line 2: 'Kd' comes before the first newmtl, so it belongs to no material");
 }
 
 }  // namespace

@@ -237,16 +237,16 @@ std::vector<std::string> obj_notes(const std::string& path, const std::string& t
 }
 
 // The material files of an OBJ (`text`) as Assimp 5.2 finds them, checked
-// before Assimp reads them (mesh_precheck.hpp): each mtllib name beside the
-// OBJ, or where there is no such file, the OBJ's own name with "mtl" for
-// its last three characters (Assimp's fallback); neither: Assimp reports it
-// and reads no material.
+// before Assimp reads them (mesh_precheck.hpp): each mtllib name appended to
+// the OBJ's directory as written in `path`, or where there is no such file,
+// the OBJ's own name with "mtl" for its last three characters (Assimp's
+// fallback); neither: Assimp reports it and reads no material.
 void check_material_files(const std::string& path, std::string_view text) {
-  for (std::string name : obj_material_libraries(text)) {
-    name.resize(std::min(name.find('\0'), name.size()));  // a C string to Assimp's file system
+  const std::string directory = path.substr(0, path.rfind('/') + 1);
+  for (const std::string& name : obj_material_libraries(text)) {
     std::error_code ec;
-    std::string mtl = (fs::path(path).parent_path() / name).string();
-    if (name.empty() || !fs::is_regular_file(mtl, ec)) mtl = path.substr(0, path.size() - 3) + "mtl";
+    std::string mtl = directory + name;
+    if (!fs::is_regular_file(mtl, ec)) mtl = path.substr(0, path.size() - 3) + "mtl";
     if (fs::is_regular_file(mtl, ec)) check_mtl_statements(path + ": material file " + mtl, read_file(mtl));
   }
 }

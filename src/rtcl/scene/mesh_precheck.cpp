@@ -48,6 +48,41 @@ std::size_t ply_type_bytes(std::string_view type) {
   return 0;
 }
 
+bool assimp_line_end(char c) { return c == '\n' || c == '\r' || c == '\0' || c == '\f'; }
+
+// Calls `visit(line, line_number)` for each line of `text` as Assimp 5.2's
+// OBJ and MTL parsers split it (its IsLineEnd): a line ends at any of '\n',
+// '\r', '\0' and '\f'. With `continuations` (the OBJ reader's
+// IOStreamBuffer::getNextDataLine), a '\\' just before a line end or the
+// end of the file is dropped with everything through the next '\n', and the
+// line goes on after it. `line_number` counts '\n' as an editor does. Stops
+// when `visit` returns false.
+template <class Visit>
+void for_each_assimp_line(std::string_view text, bool continuations, Visit&& visit) {
+  std::string joined;
+  std::size_t line_number = 1, start_line = 1;
+  for (std::size_t pos = 0; pos < text.size();) {
+    std::size_t end = pos;
+    while (end < text.size() && !assimp_line_end(text[end])) ++end;
+    std::string_view line = text.substr(pos, end - pos);
+    if (continuations && !line.empty() && line.back() == '\\') {
+      joined.append(line.substr(0, line.size() - 1));
+      std::size_t newline = text.find('\n', end);
+      if (newline == std::string_view::npos) break;
+      ++line_number;
+      pos = newline + 1;
+      continue;
+    }
+    if (!joined.empty()) line = joined.append(line);
+    if (!visit(line, start_line)) return;
+    joined.clear();
+    if (end < text.size() && text[end] == '\n') ++line_number;
+    start_line = line_number;
+    pos = end + 1;
+  }
+  if (!joined.empty()) visit(std::string_view(joined), start_line);
+}
+
 std::vector<std::string_view> words(std::string_view line) {
   std::vector<std::string_view> out;
   std::size_t i = 0;
@@ -246,32 +281,25 @@ void check_stl(const std::string& path, std::string_view bytes) {
 
 std::vector<std::string> obj_material_libraries(std::string_view text) {
   std::vector<std::string> names;
-  for (std::size_t pos = 0; pos < text.size();) {
-    std::size_t end = std::min(text.find('\n', pos), text.size());
-    std::vector<std::string_view> w = words(text.substr(pos, end - pos));
-    if (!w.empty() && w[0] == "mtllib") {
-      const char* first = w.size() > 1 ? w[1].data() : w[0].data() + w[0].size();
-      const char* last = w.back().data() + w.back().size();
-      names.emplace_back(first, static_cast<std::size_t>(last - first));
-    }
-    pos = end + 1;
-  }
+  for_each_assimp_line(text, true, [&](std::string_view line, std::size_t) {
+    std::size_t keyword_end = std::min(line.find_first_of(" \t"), line.size());
+    if (line.substr(0, keyword_end) != "mtllib") return true;
+    std::size_t name = std::min(line.find_first_not_of(" \t", keyword_end), line.size());
+    if (name < line.size()) names.emplace_back(line.substr(name));
+    return true;
+  });
   return names;
 }
 
 void check_mtl_statements(const std::string& what, std::string_view bytes) {
-  std::size_t line = 0;
-  for (std::size_t pos = 0; pos < bytes.size();) {
-    std::size_t end = std::min(bytes.find('\n', pos), bytes.size());
-    ++line;
-    std::vector<std::string_view> w = words(bytes.substr(pos, end - pos));
-    if (!w.empty() && w[0][0] != '#') {
-      if (w[0] == "newmtl") return;
-      throw Error(what + ", line " + std::to_string(line) + ": '" + std::string(w[0].substr(0, 32)) +
-                  "' comes before the first newmtl, so it belongs to no material");
-    }
-    pos = end + 1;
-  }
+  if (bytes.substr(0, 3) == "\xEF\xBB\xBF") bytes.remove_prefix(3);  // Assimp drops a UTF-8 byte order mark
+  for_each_assimp_line(bytes, false, [&](std::string_view line, std::size_t line_number) {
+    std::vector<std::string_view> w = words(line);
+    if (w.empty() || w[0][0] == '#') return true;
+    if (w[0] == "newmtl") return false;
+    throw Error(what + ", line " + std::to_string(line_number) + ": '" + std::string(w[0].substr(0, 32)) +
+                "' comes before the first newmtl, so it belongs to no material");
+  });
 }
 
 void check_declared_sizes(const std::string& path, const std::string& extension, std::string_view bytes) {

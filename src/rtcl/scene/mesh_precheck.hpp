@@ -24,15 +24,17 @@ namespace rtcl {
 void check_declared_sizes(const std::string& path, const std::string& extension, std::string_view bytes);
 
 // The material files an OBJ names (`text`: the whole OBJ), as Assimp 5.2
-// reads them: the rest of each mtllib line, without surrounding blanks
-// (empty for a bare mtllib).
+// reads them: a line ends at any of '\n', '\r', '\0' and '\f', a '\\' before
+// a line end continues the line after the next '\n', and a line that starts
+// with the word mtllib names the rest of the line after its blanks, trailing
+// blanks included (a bare mtllib names none).
 std::vector<std::string> obj_material_libraries(std::string_view text);
 
 // Throws Error naming `what` and the line when an MTL file (`bytes`: the
-// whole file) has a statement other than a comment before its first
-// newmtl: it belongs to no material, and Assimp 5.2 writes some such
-// statements through a null material (`a 0.1 newmtl x` crashed it; found
-// by fuzzing).
+// whole file, lines ended as above) has a statement other than a comment
+// before its first newmtl: it belongs to no material, and Assimp 5.2 writes
+// some such statements through a null material (`a 0.1 newmtl x` and, after
+// a NUL, `4` crashed it; found by fuzzing).
 void check_mtl_statements(const std::string& what, std::string_view bytes);
 
 }  // namespace rtcl
