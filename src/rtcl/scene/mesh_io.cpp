@@ -242,7 +242,7 @@ std::vector<std::string> obj_notes(const std::string& path, const std::string& t
 // the OBJ's own name with "mtl" for its last three characters (Assimp's
 // fallback); neither: Assimp reports it and reads no material.
 void check_material_files(const std::string& path, std::string_view text) {
-  const std::string directory = path.substr(0, path.rfind('/') + 1);
+  const std::string directory = path.substr(0, path.rfind('/') + 1);  // "" when path has no '/' (npos + 1)
   for (const std::string& name : obj_material_libraries(text)) {
     std::error_code ec;
     std::string mtl = directory + name;
