@@ -23,7 +23,7 @@ std::string embree_baseline_version(unsigned threads);
 
 class EmbreeBaseline {
  public:
-  // Builds Embree's scene of the geometry's triangles (its default, medium
+  // Builds Embree's scene of the geometry's triangles and spheres (its default, medium
   // quality build on `threads` threads; `robust`: with
   // RTC_SCENE_FLAG_ROBUST, Embree's watertight mode).
   EmbreeBaseline(const Geometry& geometry, unsigned threads, bool robust);

@@ -242,7 +242,7 @@ std::string bench_markdown(const BenchRun& run) {
         const BenchSceneInfo* info = nullptr;
         for (const BenchSceneInfo& s : run.scene_info)
           if (s.name == scene) info = &s;
-        std::size_t prims = info ? info->triangles : 0;
+        std::size_t prims = info ? info->triangles + info->spheres : 0;
         double per_prim = prims ? static_cast<double>(first->bytes) / static_cast<double>(prims) : 0.0;
         std::string check = disagreeing == 0 ? "ok " + std::to_string(checked)
                                              : "**DISAGREES " + std::to_string(disagreeing) + "/" +

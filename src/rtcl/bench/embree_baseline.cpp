@@ -108,11 +108,26 @@ const char* embree_api_name(EmbreeApi api, Query query) {
 }
 
 // Embree reads vertices with 16-byte loads: the vertex array carries one
-// float of padding after the last vertex.
+// float of padding after the last vertex. Spheres are Embree's sphere
+// points, (x, y, z, radius) per sphere.
 struct EmbreeScene::Buffers {
   std::vector<float> vertices;
   std::vector<std::uint32_t> indices;
+  std::vector<float> spheres;
+  std::uint32_t triangle_count = 0;  // a sphere's primitive id is triangle_count + its primID
 };
+
+namespace {
+// Geometry ids in Embree's scene (rtcAttachGeometryByID).
+constexpr unsigned triangles_geometry_id = 0;
+constexpr unsigned spheres_geometry_id = 1;
+
+// Our primitive id of Embree's hit: triangles first, then spheres (README,
+// "Primitive ids").
+rtcl_i32 primitive_id(unsigned geom_id, unsigned prim_id, std::uint32_t triangle_count) {
+  return static_cast<rtcl_i32>(geom_id == spheres_geometry_id ? triangle_count + prim_id : prim_id);
+}
+}  // namespace
 
 EmbreeScene::EmbreeScene(const Geometry& geometry, EmbreeQuality quality, unsigned threads, bool robust)
     : buffers_(new Buffers) {
@@ -131,6 +146,13 @@ void EmbreeScene::build(const Geometry& geometry, EmbreeQuality quality, unsigne
   buffers_->vertices.push_back(0.0f);
   buffers_->indices.reserve(3 * geometry.triangles.size());
   for (const glm::uvec3& t : geometry.triangles) buffers_->indices.insert(buffers_->indices.end(), {t.x, t.y, t.z});
+  buffers_->spheres.reserve(4 * geometry.spheres.size());
+  for (const Sphere& sp : geometry.spheres)
+    buffers_->spheres.insert(buffers_->spheres.end(), {sp.center.x, sp.center.y, sp.center.z, sp.radius});
+  buffers_->triangle_count = static_cast<std::uint32_t>(geometry.triangles.size());
+  if (!geometry.spheres.empty() && !rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_POINT_GEOMETRY_SUPPORTED))
+    throw Error("Embree: this Embree was built without point geometry, so it cannot trace the spheres of " +
+                geometry.source);
 
   long long bytes_before = embree_live_bytes.load();
   auto start = std::chrono::steady_clock::now();
@@ -139,15 +161,26 @@ void EmbreeScene::build(const Geometry& geometry, EmbreeQuality quality, unsigne
   scene_ = scene;
   rtcSetSceneFlags(scene, robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
   rtcSetSceneBuildQuality(scene, quality == EmbreeQuality::high ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
-  RTCGeometry mesh = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  rtcSetSharedGeometryBuffer(mesh, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, buffers_->vertices.data(), 0,
-                             3 * sizeof(float), geometry.vertices.size());
-  rtcSetSharedGeometryBuffer(mesh, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, buffers_->indices.data(), 0,
-                             3 * sizeof(std::uint32_t), geometry.triangles.size());
-  if (quality == EmbreeQuality::high) rtcSetGeometryBuildQuality(mesh, RTC_BUILD_QUALITY_HIGH);
-  rtcCommitGeometry(mesh);
-  rtcAttachGeometry(scene, mesh);
-  rtcReleaseGeometry(mesh);
+  if (!geometry.triangles.empty()) {
+    RTCGeometry mesh = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(mesh, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, buffers_->vertices.data(), 0,
+                               3 * sizeof(float), geometry.vertices.size());
+    rtcSetSharedGeometryBuffer(mesh, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, buffers_->indices.data(), 0,
+                               3 * sizeof(std::uint32_t), geometry.triangles.size());
+    if (quality == EmbreeQuality::high) rtcSetGeometryBuildQuality(mesh, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitGeometry(mesh);
+    rtcAttachGeometryByID(scene, mesh, triangles_geometry_id);
+    rtcReleaseGeometry(mesh);
+  }
+  if (!geometry.spheres.empty()) {
+    RTCGeometry points = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    rtcSetSharedGeometryBuffer(points, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, buffers_->spheres.data(), 0,
+                               4 * sizeof(float), geometry.spheres.size());
+    if (quality == EmbreeQuality::high) rtcSetGeometryBuildQuality(points, RTC_BUILD_QUALITY_HIGH);
+    rtcCommitGeometry(points);
+    rtcAttachGeometryByID(scene, points, spheres_geometry_id);
+    rtcReleaseGeometry(points);
+  }
   rtcCommitScene(scene);
   auto stop = std::chrono::steady_clock::now();
   check_embree(device, "building the scene");
@@ -234,6 +267,12 @@ void EmbreeScene::trace_prepared(unsigned threads) const {
 
 void EmbreeScene::answers(Hit* hits) const {
   const float inf = std::numeric_limits<float>::infinity();
+  const std::uint32_t triangle_count = buffers_->triangle_count;
+  // A closest hit as rtcl reports it: u = v = 0 on a sphere (README, "Ray and hit files").
+  auto embree_hit = [triangle_count](float t, float u, float v, unsigned geom_id, unsigned prim_id) {
+    if (geom_id == spheres_geometry_id) u = v = 0.0f;
+    return Hit{t, u, v, primitive_id(geom_id, prim_id, triangle_count)};
+  };
   const Prepared& prepared = *prepared_;
   if (prepared.api == EmbreeApi::packet8) {
     for (std::size_t i = 0; i < prepared.count; ++i) {
@@ -244,7 +283,7 @@ void EmbreeScene::answers(Hit* hits) const {
       else if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID)
         hits[i] = Hit{inf, 0.0f, 0.0f, -1};
       else
-        hits[i] = Hit{rh.ray.tfar[l], rh.hit.u[l], rh.hit.v[l], static_cast<rtcl_i32>(rh.hit.primID[l])};
+        hits[i] = embree_hit(rh.ray.tfar[l], rh.hit.u[l], rh.hit.v[l], rh.hit.geomID[l], rh.hit.primID[l]);
     }
     return;
   }
@@ -256,7 +295,7 @@ void EmbreeScene::answers(Hit* hits) const {
     else if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
       hits[i] = Hit{inf, 0.0f, 0.0f, -1};
     else
-      hits[i] = Hit{rh.ray.tfar, rh.hit.u, rh.hit.v, static_cast<rtcl_i32>(rh.hit.primID)};
+      hits[i] = embree_hit(rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.geomID, rh.hit.primID);
   }
 }
 

@@ -1,4 +1,4 @@
-// Embree 3 as the yardstick: the same triangles in one Embree scene, traced
+// Embree 3 as the yardstick: the same triangles and spheres in one Embree scene, traced
 // by host threads over our Ray records, one ray at a time (rtcIntersect1 /
 // rtcOccluded1) or in packets of eight consecutive rays (rtcIntersect8 /
 // rtcOccluded8, the groups rtcl's packet kernels take), answering into our
@@ -32,7 +32,10 @@ const char* embree_api_name(EmbreeApi api, Query query);  // e.g. "rtcIntersect8
 
 class EmbreeScene {
  public:
-  // Builds a scene with one triangle mesh; primID is the triangle index.
+  // Builds a scene with one triangle mesh and, where the geometry has
+  // spheres, one geometry of Embree's sphere points; hits report our
+  // primitive ids (triangles, then spheres). Throws Error for spheres when
+  // this Embree has no point geometry.
   // `threads`: Embree's build threads (the first scene's count configures
   // the process's one Embree device). `robust`: RTC_SCENE_FLAG_ROBUST
   // (Embree's watertight mode, "avoid optimizations that reduce arithmetic
