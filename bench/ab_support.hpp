@@ -1,6 +1,7 @@
 // Helpers of the A/B programs in bench/ (kernel_ab, ray_sort, build_ab):
 // event times, order statistics of repeated runs, comma lists, the ROUNDS
-// argument, the scenes directory and a bench/ scene's geometry.
+// argument, the image side, the scenes directory and a bench/ scene with
+// its geometry.
 #pragma once
 
 #include "rtcl/bench/scene_catalog.hpp"
@@ -58,6 +59,25 @@ inline int parse_rounds(const char* text) {
 inline std::string scenes_dir_or(const char* fallback) {
   const char* dir = std::getenv("RTCL_SCENES_DIR");
   return dir && *dir ? dir : fallback;
+}
+
+// $RTCL_BENCH_RES, the image side of the bench/ ray sets: `fallback` when
+// unset, else a positive number or an Error naming it.
+inline int bench_res(int fallback) {
+  const char* res_env = std::getenv("RTCL_BENCH_RES");
+  const int res = res_env && *res_env ? std::atoi(res_env) : fallback;
+  if (res < 1) throw Error("RTCL_BENCH_RES must be a positive number");
+  return res;
+}
+
+// The bench/ scene called `name`, which has a fixed camera and light, else
+// an Error naming it.
+inline const SceneSpec& fixed_camera_scene(const std::string& name) {
+  const SceneSpec* spec = find_scene_spec(name);
+  if (!spec || spec->fit)
+    throw Error("scene '" + name +
+                "': not a bench/ scene with a fixed camera (bunny, dragon, sponza, sibenik, teapot-stadium)");
+  return *spec;
 }
 
 // A bench/ scene's geometry: its mesh, inside its stadium where it has one.

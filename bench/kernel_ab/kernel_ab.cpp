@@ -85,9 +85,7 @@ int run(int argc, char** argv) {
     else
       versions.push_back({arg.substr(0, hash), arg.substr(hash + 1)});
   }
-  const char* res_env = std::getenv("RTCL_BENCH_RES");
-  const int res = res_env && *res_env ? std::atoi(res_env) : 512;
-  if (res < 1) throw Error("RTCL_BENCH_RES must be a positive number");
+  const int res = bench_res(512);
   const std::string scenes_dir = scenes_dir_or(RTCL_KERNEL_AB_SCENES_DIR);
   const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
   const char* sets_env = std::getenv("AB_SETS");
@@ -102,11 +100,8 @@ int run(int argc, char** argv) {
 
   Device device = Device::open();
   for (const std::string& scene_name : scenes) {
-    const SceneSpec* spec = find_scene_spec(scene_name);
-    if (!spec || spec->fit)
-      throw Error("scene '" + scene_name +
-                  "': not a bench/ scene with a fixed camera (bunny, dragon, sponza, sibenik, teapot-stadium)");
-    Geometry geometry = spec_geometry(*spec, scenes_dir);
+    const SceneSpec& spec = fixed_camera_scene(scene_name);
+    Geometry geometry = spec_geometry(spec, scenes_dir);
     validate(geometry);
 
     std::vector<std::unique_ptr<Accel>> accels;
@@ -136,10 +131,10 @@ int run(int argc, char** argv) {
       device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, rays.size() * sizeof(Hit), hits->data());
     };
 
-    std::vector<Ray> primary = primary_rays(spec->camera, res, res);
+    std::vector<Ray> primary = primary_rays(spec.camera, res, res);
     std::vector<Hit> primary_hits;
     launch(0, Query::closest, primary, &primary_hits);
-    SecondaryRays secondary = secondary_rays(geometry, primary, primary_hits, spec->light);
+    SecondaryRays secondary = secondary_rays(geometry, primary, primary_hits, spec.light);
     struct Set {
       const char* name;
       Query query;

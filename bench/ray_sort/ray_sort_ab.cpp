@@ -92,11 +92,10 @@ int run(int argc, char** argv) {
   const std::vector<std::string> scenes = split(argv[1]);
   const int rounds = parse_rounds(argv[2]);
   const std::vector<std::string> keys(argv + 3, argv + argc);
-  const char* res_env = std::getenv("RTCL_BENCH_RES");
-  const int res = res_env && *res_env ? std::atoi(res_env) : 1024;
+  const int res = bench_res(1024);
   const char* chunk_env = std::getenv("SORT_CHUNKS");
   const std::size_t chunks = chunk_env && *chunk_env ? std::strtoul(chunk_env, nullptr, 10) : 32;
-  if (res < 1 || chunks < 1) throw Error("RTCL_BENCH_RES and SORT_CHUNKS must be positive numbers");
+  if (chunks < 1) throw Error("SORT_CHUNKS must be a positive number");
   std::vector<Key> parsed;
   for (const std::string& key : keys) parsed.push_back(parse_key(key));
   const std::string scenes_dir = scenes_dir_or(RTCL_RAY_SORT_AB_SCENES_DIR);
@@ -104,9 +103,8 @@ int run(int argc, char** argv) {
   Device device = Device::open();
   cl::CommandQueue& queue = device.queue();
   for (const std::string& scene_name : scenes) {
-    const SceneSpec* spec = find_scene_spec(scene_name);
-    if (!spec || spec->fit) throw Error("scene '" + scene_name + "': not a bench/ scene with a fixed camera");
-    Geometry geometry = spec_geometry(*spec, scenes_dir);
+    const SceneSpec& spec = fixed_camera_scene(scene_name);
+    Geometry geometry = spec_geometry(spec, scenes_dir);
     validate(geometry);
     const Aabb bounds = geometry.bounds();
     std::unique_ptr<Accel> accel = make_accel(device, "bvh", geometry);
@@ -118,10 +116,10 @@ int run(int argc, char** argv) {
       hits.resize(rays.size());
       queue.enqueueReadBuffer(h, CL_TRUE, 0, rays.size() * sizeof(Hit), hits.data());
     };
-    std::vector<Ray> primary = primary_rays(spec->camera, res, res);
+    std::vector<Ray> primary = primary_rays(spec.camera, res, res);
     std::vector<Hit> primary_hits;
     trace_into(Query::closest, primary, primary_hits);
-    SecondaryRays secondary = secondary_rays(geometry, primary, primary_hits, spec->light);
+    SecondaryRays secondary = secondary_rays(geometry, primary, primary_hits, spec.light);
 
     struct Set {
       const char* name;

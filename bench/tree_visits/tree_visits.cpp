@@ -23,6 +23,7 @@
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/options.hpp"
+#include "rtcl/bounds/aabb.hpp"
 #include "rtcl/bench/ray_sets.hpp"
 #include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/cl/device.hpp"
@@ -83,29 +84,24 @@ Visits ideal_visits(const Bvh8& bvh, const Ray& ray, double t_end) {
   return v;
 }
 
-double surface_area(const Bvh8Node& node, int k) {
-  const double dx = node.bounds[3][k] - node.bounds[0][k], dy = node.bounds[4][k] - node.bounds[1][k],
-               dz = node.bounds[5][k] - node.bounds[2][k];
-  return dx < 0.0 ? 0.0 : 2.0 * (dx * dy + dy * dz + dz * dx);
+// Lane k's box of `node`.
+Aabb lane_box(const Bvh8Node& node, int k) {
+  return {{node.bounds[0][k], node.bounds[1][k], node.bounds[2][k]},
+          {node.bounds[3][k], node.bounds[4][k], node.bounds[5][k]}};
 }
 
 // The wide tree's SAH cost relative to the root box, and its blocks' filled lanes.
 void tree_cost(const Bvh8& bvh, double* cost, double* lanes_per_block) {
-  double root_lo[3] = {INFINITY, INFINITY, INFINITY}, root_hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  Aabb root;
   for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k)
-    if (bvh.nodes[0].child[k] != RTCL_CHILD_EMPTY)
-      for (int a = 0; a < 3; ++a) {
-        root_lo[a] = std::min(root_lo[a], static_cast<double>(bvh.nodes[0].bounds[a][k]));
-        root_hi[a] = std::max(root_hi[a], static_cast<double>(bvh.nodes[0].bounds[3 + a][k]));
-      }
-  const double ex = root_hi[0] - root_lo[0], ey = root_hi[1] - root_lo[1], ez = root_hi[2] - root_lo[2];
-  const double root_area = 2.0 * (ex * ey + ey * ez + ez * ex);
+    if (bvh.nodes[0].child[k] != RTCL_CHILD_EMPTY) root.grow(lane_box(bvh.nodes[0], k));
+  const double root_area = root.area();
   double area = 0.5 * root_area, blocks = 0, lanes = 0;
   for (const Bvh8Node& node : bvh.nodes)
     for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
       const rtcl_i32 child = node.child[k];
       if (child == RTCL_CHILD_EMPTY) continue;
-      area += (child >= 0 ? 0.5 : 1.0) * surface_area(node, k);
+      area += (child >= 0 ? 0.5 : 1.0) * lane_box(node, k).area();
       if (child < 0 && (~child & 1) == 0) {
         const TriangleBlock& block = bvh.blocks.triangles[static_cast<std::size_t>(~child >> 1)];
         blocks += 1;
@@ -122,21 +118,17 @@ int run(int argc, char** argv) {
     return 2;
   }
   const std::vector<std::string> scenes = split(argv[1]);
-  const char* res_env = std::getenv("RTCL_BENCH_RES");
-  const int res = res_env && std::atoi(res_env) > 0 ? std::atoi(res_env) : 256;
+  const int res = bench_res(256);
   const std::string scenes_dir = scenes_dir_or(RTCL_TREE_VISITS_SCENES_DIR);
   Device device = Device::open();
   for (const std::string& scene_name : scenes) {
-    const SceneSpec* spec = find_scene_spec(scene_name);
-    if (!spec || spec->fit)
-      throw Error("scene '" + scene_name +
-                  "': not a bench/ scene with a fixed camera (bunny, dragon, sponza, sibenik, teapot-stadium)");
-    Geometry geometry = spec_geometry(*spec, scenes_dir);
+    const SceneSpec& spec = fixed_camera_scene(scene_name);
+    Geometry geometry = spec_geometry(spec, scenes_dir);
     validate(geometry);
 
-    std::vector<Ray> primary = primary_rays(spec->camera, res, res);
+    std::vector<Ray> primary = primary_rays(spec.camera, res, res);
+    const std::unique_ptr<Accel> accel = make_accel(device, argv[2], geometry);
     auto closest_hits = [&](const std::vector<Ray>& rays) {
-      std::unique_ptr<Accel> accel = make_accel(device, argv[2], geometry);
       cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), "rays");
       cl::Buffer hit_buffer = device.allocate(rays.size() * sizeof(Hit), "hits");
       accel->trace(Query::closest, ray_buffer, hit_buffer, rays.size()).wait();
@@ -145,7 +137,7 @@ int run(int argc, char** argv) {
       return hits;
     };
     std::vector<Hit> primary_hits = closest_hits(primary);
-    std::vector<Ray> diffuse = secondary_rays(geometry, primary, primary_hits, spec->light).diffuse;
+    std::vector<Ray> diffuse = secondary_rays(geometry, primary, primary_hits, spec.light).diffuse;
     std::vector<Hit> diffuse_hits = closest_hits(diffuse);
     const struct {
       const char* name;
