@@ -114,7 +114,6 @@ struct EmbreeScene::Buffers {
   std::vector<float> vertices;
   std::vector<std::uint32_t> indices;
   std::vector<float> spheres;
-  std::uint32_t triangle_count = 0;  // a sphere's primitive id is triangle_count + its primID
 };
 
 namespace {
@@ -122,10 +121,12 @@ namespace {
 constexpr unsigned triangles_geometry_id = 0;
 constexpr unsigned spheres_geometry_id = 1;
 
-// Our primitive id of Embree's hit: triangles first, then spheres (README,
-// "Primitive ids").
-rtcl_i32 primitive_id(unsigned geom_id, unsigned prim_id, std::uint32_t triangle_count) {
-  return static_cast<rtcl_i32>(geom_id == spheres_geometry_id ? triangle_count + prim_id : prim_id);
+// Embree's closest hit as rtcl reports it: primitive ids count the
+// triangles first, then the spheres (README, "Primitive ids"), and a
+// sphere's u = v = 0 (README, "Ray and hit files").
+Hit embree_hit(float t, float u, float v, unsigned geom_id, unsigned prim_id, std::size_t triangle_count) {
+  if (geom_id != spheres_geometry_id) return Hit{t, u, v, static_cast<rtcl_i32>(prim_id)};
+  return Hit{t, 0.0f, 0.0f, static_cast<rtcl_i32>(triangle_count + prim_id)};
 }
 }  // namespace
 
@@ -149,7 +150,6 @@ void EmbreeScene::build(const Geometry& geometry, EmbreeQuality quality, unsigne
   buffers_->spheres.reserve(4 * geometry.spheres.size());
   for (const Sphere& sp : geometry.spheres)
     buffers_->spheres.insert(buffers_->spheres.end(), {sp.center.x, sp.center.y, sp.center.z, sp.radius});
-  buffers_->triangle_count = static_cast<std::uint32_t>(geometry.triangles.size());
   if (!geometry.spheres.empty() && !rtcGetDeviceProperty(device, RTC_DEVICE_PROPERTY_POINT_GEOMETRY_SUPPORTED))
     throw Error("Embree: this Embree was built without point geometry, so it cannot trace the spheres of " +
                 geometry.source);
@@ -267,12 +267,7 @@ void EmbreeScene::trace_prepared(unsigned threads) const {
 
 void EmbreeScene::answers(Hit* hits) const {
   const float inf = std::numeric_limits<float>::infinity();
-  const std::uint32_t triangle_count = buffers_->triangle_count;
-  // A closest hit as rtcl reports it: u = v = 0 on a sphere (README, "Ray and hit files").
-  auto embree_hit = [triangle_count](float t, float u, float v, unsigned geom_id, unsigned prim_id) {
-    if (geom_id == spheres_geometry_id) u = v = 0.0f;
-    return Hit{t, u, v, primitive_id(geom_id, prim_id, triangle_count)};
-  };
+  const std::size_t triangle_count = buffers_->indices.size() / 3;
   const Prepared& prepared = *prepared_;
   if (prepared.api == EmbreeApi::packet8) {
     for (std::size_t i = 0; i < prepared.count; ++i) {
@@ -283,7 +278,8 @@ void EmbreeScene::answers(Hit* hits) const {
       else if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID)
         hits[i] = Hit{inf, 0.0f, 0.0f, -1};
       else
-        hits[i] = embree_hit(rh.ray.tfar[l], rh.hit.u[l], rh.hit.v[l], rh.hit.geomID[l], rh.hit.primID[l]);
+        hits[i] = embree_hit(rh.ray.tfar[l], rh.hit.u[l], rh.hit.v[l], rh.hit.geomID[l], rh.hit.primID[l],
+                             triangle_count);
     }
     return;
   }
@@ -295,7 +291,7 @@ void EmbreeScene::answers(Hit* hits) const {
     else if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
       hits[i] = Hit{inf, 0.0f, 0.0f, -1};
     else
-      hits[i] = embree_hit(rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.geomID, rh.hit.primID);
+      hits[i] = embree_hit(rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.geomID, rh.hit.primID, triangle_count);
   }
 }
 
