@@ -569,6 +569,74 @@ TEST(Bvh, FlattenRefusesTreesTooDeepForTheStack) {
   }
 }
 
+// Shadow-like rays for the occluder cache: `count` rays from points of a
+// small patch below the soup towards one point above it, in patch order (runs
+// of neighbours share occluders); every third ray is instead a random one,
+// every fifth has its tmax cut to just before its first occluder (so the
+// previous ray's occluder, which the cache tries first, must not answer),
+// and every 97th is invalid (tmin > tmax: a miss that leaves the cache as it
+// is).
+std::vector<Ray> occlusion_rays(const Geometry& g, std::size_t count, std::uint32_t seed) {
+  std::vector<Ray> random = random_rays(g, count, seed);
+  std::vector<Ray> rays;
+  const glm::vec3 target(0.5f, 0.5f, 2.0f);
+  for (std::size_t i = 0; i < count; ++i) {
+    const float u = static_cast<float>(i % 37) / 37.0f, v = static_cast<float>(i / 37) / 37.0f;
+    const glm::vec3 origin(0.3f + 0.4f * u, 0.3f + 0.4f * v, -1.0f);
+    Ray r = i % 3 == 2 ? random[i] : Ray{origin.x, origin.y, origin.z, target.x - origin.x, target.y - origin.y,
+                                         target.z - origin.z, 0.0f, 1.0f};
+    if (i % 5 == 4) {
+      Hit first = reference_closest(g, r);
+      if (first.prim >= 0) r.tmax = 0.999f * first.t;
+    }
+    if (i % 97 == 96) r.tmin = r.tmax + 1.0f;
+    rays.push_back(r);
+  }
+  return rays;
+}
+
+// Occlusion with runs of rays per work-item, each first tested against the
+// previous ray's occluder: every answer is a valid any hit (an occluder the
+// double-precision reference confirms, or a miss only where it finds none),
+// and hit or miss is that of one ray per work-item, for runs that do and do
+// not divide the ray count, triangles and spheres.
+TEST(Bvh, OccluderRunsKeepEveryOcclusionAnswer) {
+  Geometry g = soup_with_spheres(3000, 200, 71);
+  for (std::size_t count : {std::size_t{1}, std::size_t{7}, std::size_t{1369}}) {
+    std::vector<Ray> rays = occlusion_rays(g, count, 72);
+    auto single = make_accel(test_device(), "bvh:occluder_run=1", g);
+    std::vector<Hit> want = run_query(*single, rays, Query::any);
+    std::size_t blocked = 0;
+    for (const Hit& h : want) blocked += h.prim >= 0;
+    if (count > 1000) {
+      EXPECT_GT(blocked, count / 4) << "too few occluded rays to exercise the cache";
+      EXPECT_LT(blocked, count - count / 4) << "too few unoccluded rays";
+    }
+    for (const char* spec : {"bvh:occluder_run=2", "bvh:occluder_run=3", "bvh:occluder_run=16",
+                             "bvh:occluder_run=1024", "bvh", "bvh-ploc:occluder_run=5"}) {
+      auto accel = make_accel(test_device(), spec, g);
+      std::vector<Hit> got = run_query(*accel, rays, Query::any);
+      std::size_t failures = 0, differ = 0;
+      auto report = judge_all(g, rays, got, Query::any, &failures);
+      EXPECT_EQ(failures, 0u) << spec << " on " << count << " rays: " << (report.empty() ? "" : report[0]);
+      for (std::size_t i = 0; i < rays.size(); ++i) differ += (got[i].prim >= 0) != (want[i].prim >= 0);
+      EXPECT_EQ(differ, 0u) << spec << " on " << count << " rays";
+    }
+  }
+}
+
+TEST(Bvh, OccluderRunFollowsTheDevice) {
+  BvhConfig config;
+  DeviceInfo cpu, gpu;
+  cpu.type = "cpu";
+  gpu.type = "gpu";
+  EXPECT_EQ(bvh_occluder_run(config, cpu), kCpuOccluderRun);
+  EXPECT_EQ(bvh_occluder_run(config, gpu), 1u);
+  config.occluder_run = 5;
+  EXPECT_EQ(bvh_occluder_run(config, cpu), 5u);
+  EXPECT_EQ(bvh_occluder_run(config, gpu), 5u);
+}
+
 TEST(Bvh, ReportsStats) {
   Geometry g = random_soup(1000, 61);
   auto accel = make_accel(test_device(), "bvh", g);

@@ -46,4 +46,38 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
     end_trace(hits, i, &h);                                                                         \
   }
 
+
+/* RTCL_TRACE_KERNELS for a structure whose any-hit traversal reports the
+ * leaf that blocked the ray: NAME_traverse returns that leaf's code (-1
+ * when the ray is not blocked, and always at closest hit), and
+ * NAME_leaf(code, s, h, ARGS) tests one leaf. Its any-hit kernel traces a
+ * run of ceil(ray_count / global size) consecutive rays per work-item and
+ * tests each ray first against the leaf that blocked the previous ray of
+ * the run (a shadow cache, after Haines & Greenberg 1986, "The light
+ * buffer"): rays that share an occluder skip the traversal. Any leaf that
+ * blocks the ray within [tmin, tmax] answers an any-hit query, so hit or
+ * miss is the traversal's; the reported occluder may differ. The host
+ * chooses the run by the launch's size (Accel::TraceKernels::occluder_run):
+ * one work-item per ray is a run of 1. Its closest-hit kernel is
+ * RTCL_TRACE_KERNELS's. */
+#ifdef RTCL_QUERY_ANY
+#define RTCL_TRACE_KERNELS_OCCLUDER_CACHE(NAME, PARAMS, ARGS)                                        \
+  kernel void trace_any_##NAME(global const Ray* rays, global Hit* hits, uint ray_count, PARAMS) {    \
+    ulong run = ((ulong)ray_count + get_global_size(0) - 1) / get_global_size(0);                    \
+    ulong first = get_global_id(0) * run;                                                             \
+    if (first >= ray_count) return;                                                                   \
+    uint end = (uint)min(first + run, (ulong)ray_count);                                              \
+    int occluder = -1;                                                                                \
+    for (uint i = (uint)first; i < end; ++i) {                                                        \
+      TraceRay s;                                                                                     \
+      HitState h;                                                                                     \
+      if (begin_trace(rays, i, &s, &h) && (occluder < 0 || !NAME##_leaf(occluder, &s, &h, ARGS)))     \
+        occluder = NAME##_traverse(&s, &h, ARGS);                                                     \
+      end_trace(hits, i, &h);                                                                         \
+    }                                                                                                 \
+  }
+#else
+#define RTCL_TRACE_KERNELS_OCCLUDER_CACHE RTCL_TRACE_KERNELS
+#endif
+
 #endif

@@ -58,6 +58,13 @@ struct BvhConfig {
   // 0.97-0.99x, built sponza in 3-13% more time, split no triangle of the
   // bunny and added 9 references to the dragon's 100,000.
   float presplit = 0.0f;
+  // Occlusion (Query::any) with the single-ray kernel: consecutive rays per
+  // work-item, each tested first against the leaf that blocked the previous
+  // one (a shadow cache, kernels/shared/trace.h): shadow rays in pixel order
+  // that share an occluder skip the traversal. 1 = one ray per work-item;
+  // 0 = by device: kCpuOccluderRun on CPU devices, 1 on others (a GPU wants
+  // every ray its own work-item). Hit or miss never depends on it.
+  std::uint32_t occluder_run = 0;
   // A binary builder of the caller's in place of `builder`: called once per
   // kind of primitive the geometry has (triangles, spheres; never with
   // none) with their boxes and ids, it returns a tree over exactly those ids
@@ -108,6 +115,12 @@ Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, const BvhConf
 
 // The threads the config's builder may use (its thread_count).
 unsigned bvh_thread_count(const BvhConfig& config);
+
+// BvhConfig::occluder_run's value on CPU devices when left to the device.
+inline constexpr std::uint32_t kCpuOccluderRun = 16;
+
+// The occluder run a BVH's single-ray kernel is launched with on `device`.
+std::size_t bvh_occluder_run(const BvhConfig& config, const DeviceInfo& device);
 
 // The largest traversal stack the kernel is compiled for (entries of 8 bytes
 // per work-item); a deeper tree is refused with an Error.

@@ -11,9 +11,10 @@ namespace {
 
 class MixedBvhAccel final : public Accel {
  public:
-  MixedBvhAccel(const Device& device, std::vector<std::string> defines, const Bvh8& bvh,
+  MixedBvhAccel(const Device& device, std::vector<std::string> defines, const Bvh8& bvh, std::size_t occluder_run,
                 const BvhVolumeFilters& filters, AccelStats stats, const AccelConfig& config)
-      : Accel(device, "bvh-mixed", TraceKernels{"accel/bvh.cl"}, std::nullopt, std::move(defines), stats, config),
+      : Accel(device, "bvh-mixed", TraceKernels{"accel/bvh.cl", 1, occluder_run}, std::nullopt, std::move(defines),
+              stats, config),
         nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
         primitives_(upload(device, bvh.blocks)) {
     if (filters.empty()) return;
@@ -88,7 +89,8 @@ std::unique_ptr<Accel> make_bvh_mixed(const Device& device, const Geometry& geom
   if (!filters.spheres.empty()) defines.push_back("RTCL_BVH_SPHERES");
   if (!filters.kdops.empty()) defines.push_back("RTCL_BVH_KDOP");
   if (!filters.obbs.empty()) defines.push_back("RTCL_BVH_OBB");
-  return std::make_unique<MixedBvhAccel>(device, std::move(defines), bvh, filters, stats, config);
+  return std::make_unique<MixedBvhAccel>(device, std::move(defines), bvh, bvh_occluder_run(bvh_config, device.info()),
+                                         filters, stats, config);
 }
 
 }  // namespace rtcl
