@@ -595,11 +595,12 @@ std::vector<Ray> occlusion_rays(const Geometry& g, std::size_t count, std::uint3
   return rays;
 }
 
-// Occlusion with runs of rays per work-item, each first tested against the
-// previous ray's occluder: every answer is a valid any hit (an occluder the
-// double-precision reference confirms, or a miss only where it finds none),
-// and hit or miss is that of one ray per work-item, for runs that do and do
-// not divide the ray count, triangles and spheres.
+// Occlusion with runs of rays (or packets of 8) per work-item, each first
+// tested against the previous one's occluder: every answer is a valid any
+// hit (an occluder the double-precision reference confirms, or a miss only
+// where it finds none), and hit or miss is that of one ray per work-item,
+// for runs that do and do not divide the ray or packet count, triangles
+// and spheres, single rays and packets.
 TEST(Bvh, OccluderRunsKeepEveryOcclusionAnswer) {
   Geometry g = soup_with_spheres(3000, 200, 71);
   for (std::size_t count : {std::size_t{1}, std::size_t{7}, std::size_t{1369}}) {
@@ -613,7 +614,8 @@ TEST(Bvh, OccluderRunsKeepEveryOcclusionAnswer) {
       EXPECT_LT(blocked, count - count / 4) << "too few unoccluded rays";
     }
     for (const char* spec : {"bvh:occluder_run=2", "bvh:occluder_run=3", "bvh:occluder_run=16",
-                             "bvh:occluder_run=1024", "bvh", "bvh-ploc:occluder_run=5"}) {
+                             "bvh:occluder_run=1024", "bvh", "bvh-ploc:occluder_run=5", "bvh-packet:occluder_run=1",
+                             "bvh-packet:occluder_run=3", "bvh-packet"}) {
       auto accel = make_accel(test_device(), spec, g);
       std::vector<Hit> got = run_query(*accel, rays, Query::any);
       std::size_t failures = 0, differ = 0;

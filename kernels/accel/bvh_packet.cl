@@ -172,7 +172,8 @@ inline void packet_leaf(int leaf, const TracePacket* p, const PacketFrustum* f, 
   }
 }
 
-__attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const PacketFrustum* f, PacketHits* h,
+/* Returns the last leaf that blocked rays of the packet (any hit), else -1. */
+__attribute__((noinline)) int bvh_frustum_traverse(const TracePacket* p, const PacketFrustum* f, PacketHits* h,
                                                     global const Bvh8Node* nodes,
                                                     global const TriangleBlock* triangles,
                                                     global const SphereBlock* spheres) {
@@ -181,6 +182,7 @@ __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const 
   int sp = 0;
   int ref = 0, slot = 0;
   int8 alive = p->active; /* any hit: rays still looking */
+  int blocker = -1;
   float t_far = packet_max(h->t_best, alive); /* beyond every alive ray's best hit: changes at leaves only */
   for (;;) {
     if (ref >= 0) {
@@ -199,13 +201,17 @@ __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const 
       float8 tn = packet_box(nodes + (slot >> 3), slot & 7, p, h->t_best, alive);
       int8 mask = rtcl_not_nan8(tn);
       if (rtcl_any8(mask)) {
+        int8 before = alive;
         packet_leaf(~ref, p, f, h, triangles, spheres, &alive, &mask);
-        if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
+        if (RTCL_ANY_HIT && rtcl_any8(before & ~alive)) {
+          blocker = ~ref;
+          if (!rtcl_any8(alive)) return blocker;
+        }
         t_far = packet_max(h->t_best, alive);
       }
     }
     do {
-      if (sp == 0) return;
+      if (sp == 0) return blocker;
       --sp;
     } while (!RTCL_ANY_HIT && stack_t[sp] > t_far);
     slot = stack_ref[sp];
@@ -215,15 +221,13 @@ __attribute__((noinline)) void bvh_frustum_traverse(const TracePacket* p, const 
 
 /* Traverses the packet: as one frustum when packet_frustum allows, else
  * ray by ray in the lanes. Any hit: a ray leaves the packet at its first
- * hit; the traversal ends when every ray has. */
-__attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketHits* h, global const Bvh8Node* nodes,
+ * hit; the traversal ends when every ray has. Returns the last leaf that
+ * blocked rays (any hit), else -1. */
+__attribute__((noinline)) int bvh_packet_traverse(const TracePacket* p, PacketHits* h, global const Bvh8Node* nodes,
                                                    global const TriangleBlock* triangles,
                                                    global const SphereBlock* spheres) {
   PacketFrustum frustum;
-  if (packet_frustum(p, &frustum)) {
-    bvh_frustum_traverse(p, &frustum, h, nodes, triangles, spheres);
-    return;
-  }
+  if (packet_frustum(p, &frustum)) return bvh_frustum_traverse(p, &frustum, h, nodes, triangles, spheres);
   float8 stack_t[RTCL_STACK_SIZE]; /* entry distances of stack_ref's box, NaN: ray not in it */
   int stack_ref[RTCL_STACK_SIZE];
   float stack_key[RTCL_STACK_SIZE]; /* nearest entry distance over the packet: visiting order */
@@ -231,6 +235,7 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
   int ref = 0;
   int8 alive = p->active; /* any hit: rays still looking */
   int8 mask = alive;
+  int blocker = -1;
   for (;;) {
     if (ref >= 0) {
       global const Bvh8Node* node = nodes + ref;
@@ -255,12 +260,16 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
         stack_ref[j] = child;
       }
     } else {
+      int8 before = alive;
       packet_leaf(~ref, p, 0, h, triangles, spheres, &alive, &mask);
-      if (RTCL_ANY_HIT && !rtcl_any8(alive)) return;
+      if (RTCL_ANY_HIT && rtcl_any8(before & ~alive)) {
+        blocker = ~ref;
+        if (!rtcl_any8(alive)) return blocker;
+      }
     }
     /* pop the next entry some ray still needs: entered before its best hit */
     for (;;) {
-      if (sp == 0) return;
+      if (sp == 0) return blocker;
       --sp;
       mask = alive & (stack_t[sp] <= h->t_best);
       if (rtcl_any8(mask)) break;
@@ -271,4 +280,10 @@ __attribute__((noinline)) void bvh_packet_traverse(const TracePacket* p, PacketH
 
 #define BVH_PACKET_PARAMS global const Bvh8Node *nodes, global const TriangleBlock *triangles, global const SphereBlock *spheres
 #define BVH_PACKET_ARGS nodes, triangles, spheres
-RTCL_PACKET_KERNELS(bvh_packet, BVH_PACKET_PARAMS, BVH_PACKET_ARGS)
+/* Leaf `leaf` against the packet's active rays (any hit); the rays it blocks. */
+inline int8 bvh_packet_leaf(int leaf, const TracePacket* p, PacketHits* h, BVH_PACKET_PARAMS) {
+  int8 alive = p->active, mask = p->active;
+  packet_leaf(leaf, p, 0, h, triangles, spheres, &alive, &mask);
+  return p->active & ~alive;
+}
+RTCL_PACKET_KERNELS_OCCLUDER_CACHE(bvh_packet, BVH_PACKET_PARAMS, BVH_PACKET_ARGS)

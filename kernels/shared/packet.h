@@ -296,4 +296,45 @@ inline void packet_store(const PacketHits* h, global Hit* hits, uint first, uint
     packet_store(&h, hits, first, ray_count);                                                       \
   }
 
+/* RTCL_PACKET_KERNELS with occluder runs (as RTCL_TRACE_KERNELS_OCCLUDER_CACHE
+ * in shared/trace.h, for packets): NAME##_traverse returns the last leaf
+ * that blocked rays of the packet (-1: none, and always at closest hit) and
+ * NAME##_leaf(code, &packet, &hits, ARGS) tests one leaf against the
+ * packet's active rays, returning those it blocked. The any-hit kernel
+ * traces a run of ceil(packets / global size) consecutive packets per
+ * work-item, each first against the leaf that blocked rays of the previous
+ * packet of the run; the rays it blocks leave the packet before the
+ * traversal, which is skipped when none is left. Its closest-hit kernel is
+ * RTCL_PACKET_KERNELS's. */
+#ifdef RTCL_QUERY_ANY
+#define RTCL_PACKET_KERNELS_OCCLUDER_CACHE(NAME, PARAMS, ARGS)                                        \
+  kernel void trace_any_##NAME(global const Ray* rays, global Hit* hits, uint ray_count, PARAMS) {     \
+    ulong packets = ((ulong)ray_count + 7) / 8;                                                        \
+    ulong run = (packets + get_global_size(0) - 1) / get_global_size(0);                              \
+    ulong first_packet = get_global_id(0) * run;                                                       \
+    ulong end = min(first_packet + run, packets);                                                      \
+    int occluder = -1;                                                                                 \
+    for (ulong k = first_packet; k < end; ++k) {                                                       \
+      uint first = (uint)(k * 8);                                                                      \
+      TracePacket p;                                                                                   \
+      float8 tmax;                                                                                     \
+      packet_setup(rays, first, ray_count, &p, &tmax);                                                 \
+      PacketHits h;                                                                                    \
+      packet_hits_init(&h, tmax);                                                                      \
+      int8 cached = (int8)(0);                                                                         \
+      if (occluder >= 0 && rtcl_any8(p.active)) {                                                      \
+        cached = NAME##_leaf(occluder, &p, &h, ARGS);                                                  \
+        p.active &= ~cached;                                                                           \
+      }                                                                                                \
+      if (rtcl_any8(p.active)) {                                                                       \
+        int blocked = NAME##_traverse(&p, &h, ARGS);                                                   \
+        if (blocked >= 0 || !rtcl_any8(cached)) occluder = blocked;                                    \
+      }                                                                                                \
+      packet_store(&h, hits, first, ray_count);                                                        \
+    }                                                                                                  \
+  }
+#else
+#define RTCL_PACKET_KERNELS_OCCLUDER_CACHE RTCL_PACKET_KERNELS
+#endif
+
 #endif

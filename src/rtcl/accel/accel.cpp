@@ -79,8 +79,7 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     const std::size_t group = 64;
     bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device()) >= group;
     const TraceKernels& spec = set_for(coherence).spec;
-    std::size_t per_item = query == Query::any && spec.rays_per_work_item == 1 ? spec.occluder_run
-                                                                                : spec.rays_per_work_item;
+    std::size_t per_item = spec.rays_per_work_item * (query == Query::any ? spec.occluder_run : 1);
     std::size_t items = (ray_count + per_item - 1) / per_item;
     std::size_t global = fixed ? (items + group - 1) / group * group : items;
     device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),

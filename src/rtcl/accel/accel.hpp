@@ -93,10 +93,12 @@ class Accel {
   // trace_any_bvh with -DRTCL_QUERY_ANY (two specialised programs, each
   // built at the first query of its kind). Each work-item traces
   // rays_per_work_item consecutive rays (1, or 8 for a packet kernel); a
-  // launch covers ceil(ray_count / rays_per_work_item) work-items. A
-  // single-ray file whose any-hit kernel keeps the previous ray's occluder
-  // (RTCL_TRACE_KERNELS_OCCLUDER_CACHE, kernels/shared/trace.h) is launched
-  // with occluder_run consecutive rays per work-item for Query::any.
+  // launch covers ceil(ray_count / rays_per_work_item) work-items. A file
+  // whose any-hit kernel keeps the previous ray's or packet's occluder
+  // (RTCL_TRACE_KERNELS_OCCLUDER_CACHE, kernels/shared/trace.h;
+  // RTCL_PACKET_KERNELS_OCCLUDER_CACHE, kernels/shared/packet.h) is
+  // launched with occluder_run times as many rays per work-item for
+  // Query::any.
   struct TraceKernels {
     std::string file;
     std::size_t rays_per_work_item = 1;

@@ -31,21 +31,26 @@ BuildTree build_kind(std::span<const Aabb> bounds, std::span<const std::uint32_t
 }
 
 class BvhAccel final : public Accel {
-  static inline const TraceKernels kPacket{"accel/bvh_packet.cl", RTCL_BLOCK_WIDTH};
-
  public:
   BvhAccel(const Device& device, std::string name, const BvhConfig& bvh_config, std::vector<std::string> defines,
            const Bvh8& bvh, AccelStats stats, const AccelConfig& config)
       : Accel(device, std::move(name),
-              bvh_config.traversal == BvhTraversal::packet
-                  ? kPacket
-                  : TraceKernels{"accel/bvh.cl", 1, bvh_occluder_run(bvh_config, device.info())},
-              bvh_config.traversal == BvhTraversal::packet ? std::nullopt : std::optional(kPacket), std::move(defines), stats,
-              config),
+              bvh_config.traversal == BvhTraversal::packet ? packet_kernels(bvh_config, device)
+                                                           : single_ray_kernels(bvh_config, device),
+              bvh_config.traversal == BvhTraversal::packet ? std::nullopt
+                                                           : std::optional(packet_kernels(bvh_config, device)),
+              std::move(defines), stats, config),
         nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
         primitives_(upload(device, bvh.blocks)) {}
 
  private:
+  static TraceKernels single_ray_kernels(const BvhConfig& config, const Device& device) {
+    return {"accel/bvh.cl", 1, bvh_occluder_run(config, device.info())};
+  }
+  static TraceKernels packet_kernels(const BvhConfig& config, const Device& device) {
+    return {"accel/bvh_packet.cl", RTCL_BLOCK_WIDTH, bvh_occluder_run(config, device.info())};
+  }
+
   void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
     kernel.setArg(first, nodes_);
     kernel.setArg(first + 1, primitives_.triangles);
