@@ -174,8 +174,8 @@ OptionSpec presplit_option() {
 }
 OptionSpec occluder_run_option() {
   return {"occluder_run", OptionType::integer, std::int64_t{0}, 0, 1024, false,
-          "occlusion queries: rays per work-item, each tested first against the leaf that blocked the previous "
-          "one (1 = one ray per work-item; 0 = 16 on CPU devices, 1 on others)"};
+          "occlusion queries: rays (packets of 8 in the packet kernel) per work-item, each tested first against "
+          "the leaf that blocked the previous one (1 = no such test; 0 = 16 on CPU devices, 1 on others)"};
 }
 OptionSpec max_leaf_size_option() {
   return {"max_leaf_size", OptionType::integer, std::int64_t{8}, 1, 8, false,

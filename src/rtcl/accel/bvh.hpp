@@ -58,12 +58,13 @@ struct BvhConfig {
   // 0.97-0.99x, built sponza in 3-13% more time, split no triangle of the
   // bunny and added 9 references to the dragon's 100,000.
   float presplit = 0.0f;
-  // Occlusion (Query::any) with the single-ray kernel: consecutive rays per
-  // work-item, each tested first against the leaf that blocked the previous
-  // one (a shadow cache, kernels/shared/trace.h): shadow rays in pixel order
-  // that share an occluder skip the traversal. 1 = one ray per work-item;
-  // 0 = by device: kCpuOccluderRun on CPU devices, 1 on others (a GPU wants
-  // every ray its own work-item). Hit or miss never depends on it.
+  // Occlusion (Query::any): consecutive rays per work-item (packets of 8 in
+  // the packet kernel), each tested first against the leaf that blocked the
+  // previous one (a shadow cache, kernels/shared/trace.h and packet.h):
+  // shadow rays in pixel order that share an occluder skip the traversal.
+  // 1 = no such test; 0 = by device: kCpuOccluderRun on CPU devices, 1 on
+  // others (a GPU wants every ray or packet its own work-item). Hit or miss
+  // never depends on it.
   std::uint32_t occluder_run = 0;
   // A binary builder of the caller's in place of `builder`: called once per
   // kind of primitive the geometry has (triangles, spheres; never with
