@@ -26,11 +26,12 @@ TEST(RenderRegion, TilesInAnyOrderAndSizeGiveTheWholeImage) {
     const char* what;
     Scene scene;
     Sampler sampler;
-  } cases[] = {{"default scene", default_scene(), Sampler::stratified},
-               {"cornell", load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json"), Sampler::stratified},
-               // area lights, glossy reflection and a thin lens: every sample keyed by the image's pixel
-               {"cornell_soft, sobol", load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_soft.json"),
-                Sampler::sobol}};
+  };
+  const std::string scenes = RTCL_SOURCE_DIR "/scenes/";
+  const Case cases[] = {{"default scene", default_scene(), Sampler::stratified},
+                        {"cornell", load_scene(scenes + "cornell.json"), Sampler::stratified},
+                        // area lights, glossy reflection and a thin lens: every sample keyed by the image's pixel
+                        {"cornell_soft, sobol", load_scene(scenes + "cornell_soft.json"), Sampler::sobol}};
   for (const Case& c : cases) {
     Renderer renderer(test_device(), c.scene, "bvh");
     RenderSettings s;
