@@ -156,7 +156,7 @@ TEST(Cli, RepeatedTraceReportsMinMedianMaxAndMatchesTheReference) {
 }
 
 // --coherent: the default structure traces 8-ray packets; the answers stay
-// the reference's.
+// the reference's. Without it, one ray per work-item (occlusion: in runs).
 TEST(Cli, CoherentTraceUsesPacketsAndMatchesTheReference) {
   Inputs in;
   Geometry g = load_mesh(in.mesh).geometry;
@@ -175,6 +175,13 @@ TEST(Cli, CoherentTraceUsesPacketsAndMatchesTheReference) {
   CliRun plain = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits"});
   ASSERT_EQ(plain.status, 0) << plain.err;
   EXPECT_NE(plain.out.find("one ray per work-item"), std::string::npos) << plain.out;
+  // occlusion in occluder runs: named in the report, answers still the reference's
+  CliRun runs = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits", "--any", "--accel", "bvh:occluder_run=4"});
+  ASSERT_EQ(runs.status, 0) << runs.err;
+  EXPECT_NE(runs.out.find("one ray per work-item in runs of 4"), std::string::npos) << runs.out;
+  std::size_t failures = 0;
+  auto report = judge_all(g, in.ray_list, read_hits(in.dir.file("out.hits")), Query::any, &failures);
+  EXPECT_EQ(failures, 0u) << (report.empty() ? "" : report[0]);
 }
 
 TEST(Cli, EmptyRayFileWritesAnEmptyHitFile) {

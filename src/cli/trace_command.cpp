@@ -124,6 +124,8 @@ void run_trace(const TraceOptions& options) {
   const char* kind = options.any ? "any hit (occlusion)" : "closest hit";
   std::size_t per_item = accel->rays_per_work_item(coherence);
   std::string traversal = per_item == 1 ? "one ray per work-item" : std::to_string(per_item) + "-ray packets";
+  if (std::size_t run = accel->occluder_run(coherence); options.any && run > 1)
+    traversal += " in runs of " + std::to_string(run) + ", each tested first against the previous one's occluder";
   if (rays.empty()) {
     std::printf("trace:  %s: no rays\n", kind);
   } else if (traced.trace_ms.size() == 1) {

@@ -47,6 +47,8 @@ Accel::QueryKernel& Accel::kernel_for(Coherence coherence, Query query) const {
 
 std::size_t Accel::rays_per_work_item(Coherence coherence) const { return set_for(coherence).spec.rays_per_work_item; }
 
+std::size_t Accel::occluder_run(Coherence coherence) const { return set_for(coherence).spec.occluder_run; }
+
 cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hits, std::size_t ray_count,
                        const std::vector<cl::Event>& wait, Coherence coherence) const {
   return with_cl_errors([&] {

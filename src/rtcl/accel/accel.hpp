@@ -70,6 +70,10 @@ class Accel {
   // Consecutive rays one work-item traces in calls of this coherence: 1
   // (single-ray kernel) or 8 (packet kernel).
   std::size_t rays_per_work_item(Coherence coherence) const;
+  // For Query::any in calls of this coherence: how many rays (packets, for
+  // a packet kernel) one work-item traces in turn, each first tested
+  // against the leaf that blocked the previous one; 1: no such test.
+  std::size_t occluder_run(Coherence coherence) const;
 
   // The -D options (and -cl-... flags) its trace programs are built with,
   // before the query's RTCL_QUERY_CLOSEST / RTCL_QUERY_ANY.
