@@ -50,6 +50,9 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
     EXPECT_GT(cell["check"]["rays"].get<int>(), 0) << cell.dump();
     EXPECT_EQ(cell["query"], cell["rays"] == "shadow" ? "any" : "closest");
     EXPECT_EQ(cell["precision"], "robust");
+    // occlusion in runs: the BVHs' shadow cells on a CPU device, no other cell
+    const bool runs = cell["rays"] == "shadow" && cell["accel"] != "grid" && json["devices"][0]["type"] == "cpu";
+    EXPECT_EQ(cell["occluder_run"].get<int>(), runs ? 16 : 1) << cell.dump();
     ASSERT_TRUE(cell.contains("embree"));
 #ifdef RTCL_TESTS_EXPECT_EMBREE
     // packets against packets: the packet kernel is compared with rtcIntersect8 / rtcOccluded8

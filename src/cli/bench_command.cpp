@@ -297,6 +297,7 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
     cell.device_bytes = stats.device_bytes;
     cell.primitives = stats.primitive_count;
     cell.packets = accel->rays_per_work_item(Coherence::incoherent) > 1;
+    if (kind_query(k) == Query::any) cell.occluder_run = accel->occluder_run(Coherence::incoherent);
     measure(*accel, *scene.rays, k, repeat, embree && (!cell.packets || embree->has_packets()) ? embree : nullptr,
             cell);
     cells.push_back(std::move(cell));

@@ -83,6 +83,7 @@ json cell_json(const BenchCell& c, const BenchBaseline* baseline) {
       {"setup_ms", c.setup_ms},
       {"first_launch_ms", c.first_launch_ms},
       {"packets", c.packets},
+      {"occluder_run", c.occluder_run},
       {"device_bytes", c.device_bytes},
       {"primitives", c.primitives},
       {"bytes_per_primitive",

@@ -36,6 +36,10 @@ struct BenchCell {
   // Whether the structure traces packets of eight consecutive rays (its
   // compared with Embree's packet API, else with its single-ray API).
   bool packets = false;
+  // Shadow cells: rays (packets) a work-item traces in turn, each first
+  // tested against the previous one's occluder (Accel::occluder_run); 1
+  // for closest-hit cells and structures without occluder runs.
+  std::size_t occluder_run = 1;
   // Embree's traversal of the same rays right after each timed launch (its
   // API as `packets` says), when the run has the baseline and Embree traces
   // such packets: the cell's ratio is taken from these.
