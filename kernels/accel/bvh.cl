@@ -85,8 +85,9 @@
 /* Leaf `leaf` (~ a child reference: its block index times two, plus one for
  * spheres) against the ray; whether it hit. Always inlined: called, it cost
  * the closest-hit traversal 3-20% (sponza's primary rays most). */
-inline __attribute__((always_inline)) int bvh_test_leaf(int leaf, const TraceRay* s, HitState* h, global const TriangleBlock* triangles,
-                         global const SphereBlock* spheres) {
+inline __attribute__((always_inline)) int bvh_test_leaf(int leaf, const TraceRay* s, HitState* h,
+                                                        global const TriangleBlock* triangles,
+                                                        global const SphereBlock* spheres) {
 #ifdef RTCL_HAS_SPHERES
   if (leaf & 1) return intersect_spheres8(spheres + (leaf >> 1), s, h);
 #endif

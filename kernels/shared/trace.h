@@ -46,7 +46,6 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
     end_trace(hits, i, &h);                                                                         \
   }
 
-
 /* RTCL_TRACE_KERNELS for a structure whose any-hit traversal reports the
  * leaf that blocked the ray: NAME_traverse returns that leaf's code (-1
  * when the ray is not blocked, and always at closest hit), and
