@@ -600,7 +600,8 @@ std::vector<Ray> occlusion_rays(const Geometry& g, std::size_t count, std::uint3
 // hit (an occluder the double-precision reference confirms, or a miss only
 // where it finds none), and hit or miss is that of one ray per work-item,
 // for runs that do and do not divide the ray or packet count, triangles
-// and spheres, single rays and packets.
+// and spheres, single rays and packets; the kd-tree and the BSP, whose
+// any-hit kernel has occluder runs too, alike.
 TEST(Bvh, OccluderRunsKeepEveryOcclusionAnswer) {
   Geometry g = soup_with_spheres(3000, 200, 71);
   for (std::size_t count : {std::size_t{1}, std::size_t{7}, std::size_t{1369}}) {
@@ -615,7 +616,8 @@ TEST(Bvh, OccluderRunsKeepEveryOcclusionAnswer) {
     }
     for (const char* spec : {"bvh:occluder_run=2", "bvh:occluder_run=3", "bvh:occluder_run=16",
                              "bvh:occluder_run=1024", "bvh", "bvh-ploc:occluder_run=5", "bvh-packet:occluder_run=1",
-                             "bvh-packet:occluder_run=3", "bvh-packet"}) {
+                             "bvh-packet:occluder_run=3", "bvh-packet", "kdtree:occluder_run=3", "kdtree",
+                             "bsp:occluder_run=7", "bsp"}) {
       auto accel = make_accel(test_device(), spec, g);
       std::vector<Hit> got = run_query(*accel, rays, Query::any);
       std::size_t failures = 0, differ = 0;
@@ -628,15 +630,13 @@ TEST(Bvh, OccluderRunsKeepEveryOcclusionAnswer) {
 }
 
 TEST(Bvh, OccluderRunFollowsTheDevice) {
-  BvhConfig config;
   DeviceInfo cpu, gpu;
   cpu.type = "cpu";
   gpu.type = "gpu";
-  EXPECT_EQ(bvh_occluder_run(config, cpu), kCpuOccluderRun);
-  EXPECT_EQ(bvh_occluder_run(config, gpu), 1u);
-  config.occluder_run = 5;
-  EXPECT_EQ(bvh_occluder_run(config, cpu), 5u);
-  EXPECT_EQ(bvh_occluder_run(config, gpu), 5u);
+  EXPECT_EQ(occluder_run_for(0, cpu), kCpuOccluderRun);
+  EXPECT_EQ(occluder_run_for(0, gpu), 1u);
+  EXPECT_EQ(occluder_run_for(5, cpu), 5u);
+  EXPECT_EQ(occluder_run_for(5, gpu), 5u);
 }
 
 TEST(Bvh, ReportsStats) {

@@ -119,7 +119,9 @@ inline int8 kd_enter_cells8(global const Bvh8Node* node, const TraceRay* s, floa
 #endif
 }
 
-__attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, global const KdHeader* header,
+/* Returns the leaf (its index in nodes) that ended an any-hit traversal,
+ * else -1. */
+__attribute__((noinline)) int kdtree_traverse(const TraceRay* s, HitState* h, global const KdHeader* header,
                                                global const KdNode* nodes, global const Bvh8Node* fused,
                                                global const int* refs, global const float* lanes,
                                                global const int* lane_prims, global const SphereBlock* spheres) {
@@ -139,10 +141,10 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
     } else {
       KdNode leaf = nodes[~ref];
       uint first = leaf.flags >> 2;
-      if (kd_test_leaf(refs, first, first + leaf.data, lanes, lane_stride, lane_prims, spheres, s, h)) return;
+      if (kd_test_leaf(refs, first, first + leaf.data, lanes, lane_stride, lane_prims, spheres, s, h)) return ~ref;
     }
     do {
-      if (sp == 0) return;
+      if (sp == 0) return -1;
       --sp;
     } while (!RTCL_ANY_HIT && stack_t[sp] > h->t_best);
     ref = stack_ref[sp];
@@ -153,4 +155,10 @@ __attribute__((noinline)) void kdtree_traverse(const TraceRay* s, HitState* h, g
   global const KdHeader *header, global const KdNode *nodes, global const Bvh8Node *fused, global const int *refs, \
       global const float *lanes, global const int *lane_prims, global const SphereBlock *spheres
 #define KD_ARGS header, nodes, fused, refs, lanes, lane_prims, spheres
-RTCL_TRACE_KERNELS(kdtree, KD_PARAMS, KD_ARGS)
+/* Leaf nodes[leaf] against the ray; whether it hit (any hit). */
+inline int kdtree_leaf(int leaf, const TraceRay* s, HitState* h, KD_PARAMS) {
+  KdNode node = nodes[leaf];
+  uint first = node.flags >> 2;
+  return kd_test_leaf(refs, first, first + node.data, lanes, header->lane_stride, lane_prims, spheres, s, h);
+}
+RTCL_TRACE_KERNELS_OCCLUDER_CACHE(kdtree, KD_PARAMS, KD_ARGS)

@@ -98,6 +98,17 @@ cl::Event Accel::trace(Query query, cl_mem rays, cl_mem hits, std::size_t ray_co
       [&] { return trace(query, cl::Buffer(rays, true), cl::Buffer(hits, true), ray_count, wait, coherence); });
 }
 
+std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device) {
+  if (requested > 0) return requested;
+  return device.type == "cpu" ? kCpuOccluderRun : 1;
+}
+
+OptionSpec occluder_run_option() {
+  return {"occluder_run", OptionType::integer, std::int64_t{0}, 0, 1024, false,
+          "occlusion queries: rays (packets of 8 in a packet kernel) per work-item, each tested first against the "
+          "leaf that blocked the previous one (1 = no such test; 0 = 16 on CPU devices, 1 on others)"};
+}
+
 std::vector<std::string> primitive_defines(const Geometry& geometry) {
   std::vector<std::string> defines;
   if (!geometry.spheres.empty()) defines.push_back("RTCL_HAS_SPHERES");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -159,6 +160,16 @@ std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, c
                                   const AccelConfig& config = {});
 
 // The -D options every trace program needs for this geometry.
+// Occluder runs (Accel::TraceKernels::occluder_run) of a structure whose
+// any-hit kernels have them (the BVHs, the kd-tree and the BSP): the
+// structure's `occluder_run` option when > 0, else kCpuOccluderRun on CPU
+// devices and 1 on others (a GPU needs every ray or packet as a work-item
+// of its own to fill its lanes).
+inline constexpr std::uint32_t kCpuOccluderRun = 16;
+std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device);
+// That option, as such structures declare it.
+OptionSpec occluder_run_option();
+
 std::vector<std::string> primitive_defines(const Geometry& geometry);
 
 }  // namespace rtcl

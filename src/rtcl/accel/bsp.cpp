@@ -105,7 +105,8 @@ const StructureSpec& bsp_structure() {
         "deepest leaf in splits, at most the traversal stack; 0: round(log2 N) + 6. Deeper cuts clusters finer "
         "for more nodes and more straddling references"},
        {"leaf", OptionType::integer, std::int64_t{BspConfig{}.leaf_size}, 1, 1024, false,
-        "a node with at most this many primitives is a leaf: fewer test less per leaf for more nodes to walk"}}};
+        "a node with at most this many primitives is a leaf: fewer test less per leaf for more nodes to walk"},
+       occluder_run_option()}};
   return spec;
 }
 
@@ -118,7 +119,7 @@ std::unique_ptr<Accel> make_bsp(const Device& device, const Geometry& geometry, 
         if (!limited.max_alloc_bytes) limited.max_alloc_bytes = max_alloc_bytes;
         return build_bsp(geometry, limited);
       },
-      accel_config);
+      accel_config, KdTraversal::single, config.occluder_run);
 }
 
 std::unique_ptr<Accel> make_bsp_accel(const Device& device, const Geometry& geometry, const AccelConfig& config) {
@@ -126,6 +127,7 @@ std::unique_ptr<Accel> make_bsp_accel(const Device& device, const Geometry& geom
   BspConfig bsp;
   bsp.depth = static_cast<int>(o.integer("depth"));
   bsp.leaf_size = static_cast<int>(o.integer("leaf"));
+  bsp.occluder_run = static_cast<std::uint32_t>(o.integer("occluder_run"));
   return make_bsp(device, geometry, bsp, config);
 }
 

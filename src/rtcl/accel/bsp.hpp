@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 
 #include "rtcl/accel/kdtree_nodes.hpp"
@@ -31,6 +32,10 @@ struct BspConfig {
   unsigned thread_count = 0;
   // The largest buffer the device can allocate (0: no limit).
   std::size_t max_alloc_bytes = 0;
+  // Occlusion with the single-ray kernel: consecutive rays per work-item,
+  // each tested first against the leaf that blocked the previous one; 1 =
+  // no such test, 0 = by device (occluder_run_for, accel.hpp).
+  std::uint32_t occluder_run = 0;
 };
 
 // The depth the build uses for `primitives` stored primitives.

@@ -45,10 +45,10 @@ class BvhAccel final : public Accel {
 
  private:
   static TraceKernels single_ray_kernels(const BvhConfig& config, const Device& device) {
-    return {"accel/bvh.cl", 1, bvh_occluder_run(config, device.info())};
+    return {"accel/bvh.cl", 1, occluder_run_for(config.occluder_run, device.info())};
   }
   static TraceKernels packet_kernels(const BvhConfig& config, const Device& device) {
-    return {"accel/bvh_packet.cl", RTCL_BLOCK_WIDTH, bvh_occluder_run(config, device.info())};
+    return {"accel/bvh_packet.cl", RTCL_BLOCK_WIDTH, occluder_run_for(config.occluder_run, device.info())};
   }
 
   void set_structure_args(cl::Kernel& kernel, cl_uint first) const override {
@@ -116,11 +116,6 @@ Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, const BvhConf
   return flatten_bvh8(tree, geometry, config.merge_leaves, bvh_thread_count(config), config.presplit > 0.0f);
 }
 
-std::size_t bvh_occluder_run(const BvhConfig& config, const DeviceInfo& device) {
-  if (config.occluder_run > 0) return config.occluder_run;
-  return device.type == "cpu" ? kCpuOccluderRun : 1;
-}
-
 std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size) { return std::max(8u, (stack_size + 7u) / 8u * 8u); }
 
 AccelStats bvh_stats(const Geometry& geometry, const GeometryReport& report, const Bvh8& bvh,
@@ -171,11 +166,6 @@ OptionSpec presplit_option() {
   return {"presplit", OptionType::real, 0.0, 0, 1024, false,
           "split the references of triangles whose box's area exceeds presplit x the mean (0 = off): at 16 "
           "sponza's primary rays 1.13-1.16x faster, diffuse bounces 0.97-0.99x, 3-13% more build time"};
-}
-OptionSpec occluder_run_option() {
-  return {"occluder_run", OptionType::integer, std::int64_t{0}, 0, 1024, false,
-          "occlusion queries: rays (packets of 8 in the packet kernel) per work-item, each tested first against "
-          "the leaf that blocked the previous one (1 = no such test; 0 = 16 on CPU devices, 1 on others)"};
 }
 OptionSpec max_leaf_size_option() {
   return {"max_leaf_size", OptionType::integer, std::int64_t{8}, 1, 8, false,

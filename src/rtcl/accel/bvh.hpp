@@ -62,9 +62,8 @@ struct BvhConfig {
   // the packet kernel), each tested first against the leaf that blocked the
   // previous one (a shadow cache, kernels/shared/trace.h and packet.h):
   // shadow rays in pixel order that share an occluder skip the traversal.
-  // 1 = no such test; 0 = by device: kCpuOccluderRun on CPU devices, 1 on
-  // others (a GPU wants every ray or packet its own work-item). Hit or miss
-  // never depends on it.
+  // 1 = no such test; 0 = by device (occluder_run_for, accel.hpp). Hit or
+  // miss never depends on it.
   std::uint32_t occluder_run = 0;
   // A binary builder of the caller's in place of `builder`: called once per
   // kind of primitive the geometry has (triangles, spheres; never with
@@ -116,12 +115,6 @@ Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, const BvhConf
 
 // The threads the config's builder may use (its thread_count).
 unsigned bvh_thread_count(const BvhConfig& config);
-
-// BvhConfig::occluder_run's value on CPU devices when left to the device.
-inline constexpr std::uint32_t kCpuOccluderRun = 16;
-
-// The occluder run a BVH's single-ray kernel is launched with on `device`.
-std::size_t bvh_occluder_run(const BvhConfig& config, const DeviceInfo& device);
 
 // The largest traversal stack the kernel is compiled for (entries of 8 bytes
 // per work-item); a deeper tree is refused with an Error.

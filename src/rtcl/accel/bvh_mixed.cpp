@@ -89,7 +89,7 @@ std::unique_ptr<Accel> make_bvh_mixed(const Device& device, const Geometry& geom
   if (!filters.spheres.empty()) defines.push_back("RTCL_BVH_SPHERES");
   if (!filters.kdops.empty()) defines.push_back("RTCL_BVH_KDOP");
   if (!filters.obbs.empty()) defines.push_back("RTCL_BVH_OBB");
-  return std::make_unique<MixedBvhAccel>(device, std::move(defines), bvh, bvh_occluder_run(bvh_config, device.info()),
+  return std::make_unique<MixedBvhAccel>(device, std::move(defines), bvh, occluder_run_for(bvh_config.occluder_run, device.info()),
                                          filters, stats, config);
 }
 

@@ -656,7 +656,8 @@ std::vector<OptionSpec> kdtree_options() {
            "primitives per intersection test in the SAH (1: classic; 8: the kernel's float8 batch, larger leaves)"},
           {"exact", OptionType::integer, static_cast<std::int64_t>(d.exact_below), 0, 1073741824.0, false,
            "nodes of at most this many references split by the exact sweep over sorted events, larger ones at 64 bin "
-           "boundaries per axis"}};
+           "boundaries per axis"},
+          occluder_run_option()};
 }
 
 std::unique_ptr<Accel> make_kdtree_from(const StructureSpec& spec, KdTraversal traversal, const Device& device,
@@ -669,6 +670,7 @@ std::unique_ptr<Accel> make_kdtree_from(const StructureSpec& spec, KdTraversal t
   kd.empty_bonus = o.real("empty");
   kd.batch = static_cast<unsigned>(o.integer("batch"));
   kd.exact_below = static_cast<std::size_t>(o.integer("exact"));
+  kd.occluder_run = static_cast<std::uint32_t>(o.integer("occluder_run"));
   return make_kdtree(device, geometry, kd, config, spec.name, traversal);
 }
 
@@ -698,7 +700,7 @@ std::unique_ptr<Accel> make_kdtree(const Device& device, const Geometry& geometr
         if (!limited.max_alloc_bytes) limited.max_alloc_bytes = max_alloc_bytes;
         return build_kdtree(geometry, limited);
       },
-      accel_config, traversal);
+      accel_config, traversal, config.occluder_run);
 }
 
 std::unique_ptr<Accel> make_kdtree_accel(const Device& device, const Geometry& geometry,

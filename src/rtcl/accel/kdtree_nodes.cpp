@@ -245,13 +245,15 @@ bool KdThreads::try_take() {
 namespace {
 
 class KdAccel final : public Accel {
-  static inline const TraceKernels kSingle{"accel/kdtree.cl"};
   static inline const TraceKernels kPacket{"accel/kdtree_packet.cl", 8};
 
  public:
   KdAccel(const Device& device, const Geometry& geometry, const std::string& name, const KdTree& tree,
-          AccelStats stats, const AccelConfig& config, KdTraversal traversal)
-      : Accel(device, name, traversal == KdTraversal::packet ? kPacket : kSingle,
+          AccelStats stats, const AccelConfig& config, KdTraversal traversal, std::uint32_t occluder_run)
+      : Accel(device, name,
+              traversal == KdTraversal::packet
+                  ? kPacket
+                  : TraceKernels{"accel/kdtree.cl", 1, occluder_run_for(occluder_run, device.info())},
               traversal == KdTraversal::by_coherence ? std::optional(kPacket) : std::nullopt, defines(geometry),
               stats, config),
         header_(device.upload(&tree.header, sizeof tree.header, (name + " header").c_str())),
@@ -294,8 +296,8 @@ class KdAccel final : public Accel {
 
 std::unique_ptr<Accel> make_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
                                      const KdTree& tree, AccelStats stats, const AccelConfig& config,
-                                     KdTraversal traversal) {
-  return std::make_unique<KdAccel>(device, geometry, name, tree, stats, config, traversal);
+                                     KdTraversal traversal, std::uint32_t occluder_run) {
+  return std::make_unique<KdAccel>(device, geometry, name, tree, stats, config, traversal, occluder_run);
 }
 
 }  // namespace rtcl
@@ -304,7 +306,7 @@ namespace rtcl {
 
 std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
                                       const std::function<KdTree(std::size_t max_alloc_bytes)>& build,
-                                      const AccelConfig& config, KdTraversal traversal) {
+                                      const AccelConfig& config, KdTraversal traversal, std::uint32_t occluder_run) {
   auto start = std::chrono::steady_clock::now();
   GeometryReport report = validate(geometry);
   KdTree tree = build(device.info().max_alloc_bytes);
@@ -315,7 +317,7 @@ std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geom
   stats.zero_area_skipped = report.zero_area_triangles;
   stats.node_count = tree.nodes.size() - tree.leaf_count;
   stats.leaf_count = tree.leaf_count;
-  return make_kd_accel(device, geometry, name, tree, stats, config, traversal);
+  return make_kd_accel(device, geometry, name, tree, stats, config, traversal, occluder_run);
 }
 
 }  // namespace rtcl

@@ -163,16 +163,19 @@ enum class KdTraversal {
 };
 
 // Uploads the tree as structure `name` (the kernels of accel/kdtree.cl and
-// accel/kdtree_packet.cl, chosen by `traversal`).
+// accel/kdtree_packet.cl, chosen by `traversal`). occluder_run: the
+// structure's `occluder_run` option (occluder_run_for, accel.hpp), for the
+// single-ray kernel's occlusion queries.
 std::unique_ptr<Accel> make_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
                                      const KdTree& tree, AccelStats stats, const AccelConfig& config,
-                                     KdTraversal traversal = KdTraversal::single);
+                                     KdTraversal traversal = KdTraversal::single, std::uint32_t occluder_run = 0);
 
 // Validates the geometry, builds with build(max_alloc_bytes), the device's
 // largest buffer, and uploads as `name`; stats().build_ms covers the
 // validation and the build.
 std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geometry, const std::string& name,
                                       const std::function<KdTree(std::size_t max_alloc_bytes)>& build,
-                                      const AccelConfig& config, KdTraversal traversal = KdTraversal::single);
+                                      const AccelConfig& config, KdTraversal traversal = KdTraversal::single,
+                                      std::uint32_t occluder_run = 0);
 
 }  // namespace rtcl
