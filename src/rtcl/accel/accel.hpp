@@ -159,7 +159,6 @@ std::vector<std::string> accel_names();
 std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry,
                                   const AccelConfig& config = {});
 
-// The -D options every trace program needs for this geometry.
 // Occluder runs (Accel::TraceKernels::occluder_run) of a structure whose
 // any-hit kernels have them (the BVHs, the kd-tree and the BSP): the
 // structure's `occluder_run` option when > 0, else kCpuOccluderRun on CPU
@@ -170,6 +169,7 @@ std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device);
 // That option, as such structures declare it.
 OptionSpec occluder_run_option();
 
+// The -D options every trace program needs for this geometry.
 std::vector<std::string> primitive_defines(const Geometry& geometry);
 
 }  // namespace rtcl

@@ -642,9 +642,11 @@ KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config) {
 
 namespace {
 
-std::vector<OptionSpec> kdtree_options() {
+// The build options; with the single-ray kernel's occlusion queries
+// (`kdtree`) also occluder_run, which the packet kernel does not have.
+std::vector<OptionSpec> kdtree_options(bool occluder_runs) {
   static const KdTreeConfig d;
-  return {{"depth", OptionType::integer, std::int64_t{0}, 0, kKdMaxDepth, false,
+  std::vector<OptionSpec> options = {{"depth", OptionType::integer, std::int64_t{0}, 0, kKdMaxDepth, false,
            "deepest leaf in splits, at most the traversal stack; 0: round(8 + 1.3 log2 N)"},
           {"ct", OptionType::real, d.traversal_cost, 0, 1e6, true,
            "SAH cost of one node step: higher makes shallower trees with larger leaves"},
@@ -656,8 +658,9 @@ std::vector<OptionSpec> kdtree_options() {
            "primitives per intersection test in the SAH (1: classic; 8: the kernel's float8 batch, larger leaves)"},
           {"exact", OptionType::integer, static_cast<std::int64_t>(d.exact_below), 0, 1073741824.0, false,
            "nodes of at most this many references split by the exact sweep over sorted events, larger ones at 64 bin "
-           "boundaries per axis"},
-          occluder_run_option()};
+           "boundaries per axis"}};
+  if (occluder_runs) options.push_back(occluder_run_option());
+  return options;
 }
 
 std::unique_ptr<Accel> make_kdtree_from(const StructureSpec& spec, KdTraversal traversal, const Device& device,
@@ -670,7 +673,7 @@ std::unique_ptr<Accel> make_kdtree_from(const StructureSpec& spec, KdTraversal t
   kd.empty_bonus = o.real("empty");
   kd.batch = static_cast<unsigned>(o.integer("batch"));
   kd.exact_below = static_cast<std::size_t>(o.integer("exact"));
-  kd.occluder_run = static_cast<std::uint32_t>(o.integer("occluder_run"));
+  if (o.has("occluder_run")) kd.occluder_run = static_cast<std::uint32_t>(o.integer("occluder_run"));
   return make_kdtree(device, geometry, kd, config, spec.name, traversal);
 }
 
@@ -681,13 +684,13 @@ const StructureSpec& kdtree_structure() {
       "kdtree",
       "SAH kd-tree: O(N log N) sorted-event build, perfect splits, [min,max] interval traversal; packets of 8 rays "
       "for coherent calls",
-      kdtree_options()};
+      kdtree_options(true)};
   return spec;
 }
 
 const StructureSpec& kdtree_packet_structure() {
   static const StructureSpec spec{"kdtree-packet", "the kdtree, always traced in packets of 8 rays (for measuring)",
-                                  kdtree_options()};
+                                  kdtree_options(false)};
   return spec;
 }
 
