@@ -77,7 +77,8 @@ TEST(AccelOptions, BadOptionsNameTheStructureAndTheOption) {
             std::string::npos);
   EXPECT_NE(error_of_spec("grid:res=64x-2x16").find("res must be"), std::string::npos);
   EXPECT_NE(error_of_spec("grid:res=64x32").find("res must be AxBxC"), std::string::npos);
-  EXPECT_NE(error_of_spec("grid:foo=1").find("unknown option foo (options of grid: lambda, res, macro)"), std::string::npos);
+  EXPECT_NE(error_of_spec("grid:foo=1").find("unknown option foo (options of grid: lambda, res, macro, occluder_run)"),
+            std::string::npos);
   EXPECT_NE(error_of_spec("grid:macro=3").find("macro must be a power of two in [1, 256]"), std::string::npos);
   EXPECT_NE(error_of_spec("grid:macro=512").find("macro must be a power of two in [1, 256]"), std::string::npos);
   EXPECT_NE(error_of_spec("brute:lambda=1").find("brute has no options"), std::string::npos);

@@ -600,8 +600,8 @@ std::vector<Ray> occlusion_rays(const Geometry& g, std::size_t count, std::uint3
 // hit (an occluder the double-precision reference confirms, or a miss only
 // where it finds none), and hit or miss is that of one ray per work-item,
 // for runs that do and do not divide the ray or packet count, triangles
-// and spheres, single rays and packets; the kd-tree and the BSP, whose
-// any-hit kernel has occluder runs too, alike.
+// and spheres, single rays and packets; the kd-tree, the BSP, the grid and
+// the octrees, whose any-hit kernels have occluder runs too, alike.
 TEST(Bvh, OccluderRunsKeepEveryOcclusionAnswer) {
   Geometry g = soup_with_spheres(3000, 200, 71);
   for (std::size_t count : {std::size_t{1}, std::size_t{7}, std::size_t{1369}}) {
@@ -617,7 +617,8 @@ TEST(Bvh, OccluderRunsKeepEveryOcclusionAnswer) {
     for (const char* spec : {"bvh:occluder_run=2", "bvh:occluder_run=3", "bvh:occluder_run=16",
                              "bvh:occluder_run=1024", "bvh", "bvh-ploc:occluder_run=5", "bvh-packet:occluder_run=1",
                              "bvh-packet:occluder_run=3", "bvh-packet", "kdtree:occluder_run=3", "kdtree",
-                             "bsp:occluder_run=7", "bsp"}) {
+                             "bsp:occluder_run=7", "bsp", "grid:occluder_run=3", "grid", "octree:occluder_run=6",
+                             "octree", "octree-ptr:occluder_run=2", "octree-ptr", "octree-r"}) {
       auto accel = make_accel(test_device(), spec, g);
       std::vector<Hit> got = run_query(*accel, rays, Query::any);
       std::size_t failures = 0, differ = 0;

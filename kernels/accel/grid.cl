@@ -60,7 +60,7 @@ inline int grid_step(float d, float inv) { return (d == 0.0f || !rtcl_is_finite(
   if (sphere_count > 0) {                                                               \
     int found = intersect_sphere_refs(spheres, sphere_batch, sphere_count, s, h);       \
     sphere_count = 0;                                                                   \
-    if (found && RTCL_ANY_HIT) return;                                                  \
+    if (found && RTCL_ANY_HIT) return -1;                                               \
   }
 #else
 #define GRID_FLUSH_SPHERES()
@@ -68,7 +68,7 @@ inline int grid_step(float d, float inv) { return (d == 0.0f || !rtcl_is_finite(
 #define GRID_FINISH()     \
   {                       \
     GRID_FLUSH_SPHERES()  \
-    return;               \
+    return -1;            \
   }
 
 /* Steps the walk across axis A's exit plane: the cell coordinate, the cell
@@ -161,18 +161,21 @@ inline int grid_entry_cell(float o, float d, float inv, float lower, float cell,
   return grid_cell_at(o, d, inv, lower, cell, macro << shift, min((macro + 1) << shift, res) - 1, step, t, t_next);
 }
 
-__attribute__((noinline)) void grid_traverse(const TraceRay* s, HitState* h, global const GridHeader* header,
-                                             global const uint* cell_begin, global const int* refs,
-                                             global const uchar* macro_occupied,
-                                             global const float8* occupied_boxes, global const float* lanes,
-                                             global const int* lane_prims, global const SphereBlock* spheres) {
+/* Returns the cell (its index) whose triangles ended an any-hit traversal,
+ * else -1 (also when a batch of spheres, gathered over several cells, ended
+ * it). */
+__attribute__((noinline)) int grid_traverse(const TraceRay* s, HitState* h, global const GridHeader* header,
+                                            global const uint* cell_begin, global const int* refs,
+                                            global const uchar* macro_occupied,
+                                            global const float8* occupied_boxes, global const float* lanes,
+                                            global const int* lane_prims, global const SphereBlock* spheres) {
   const GridHeader g = *header;
   /* The occupied space: the ray's interval over the octant boxes it meets,
    * narrowed to the sub-octant boxes it meets in them (widened slabs,
    * shared/box.h); nothing to find outside [t0, t1]. */
   float8 t_in, t_out;
   int8 hit = intersect_box_rows8((global const float8*)header->occupied_bounds, s, s->tmax, &t_in, &t_out);
-  if (!any(hit)) return;
+  if (!any(hit)) return -1;
   int octants[8];
   vstore8(hit, 0, octants);
   float8 t_first = (float8)(INFINITY), t_last = (float8)(-INFINITY);
@@ -185,7 +188,7 @@ __attribute__((noinline)) void grid_traverse(const TraceRay* s, HitState* h, glo
   const float4 in4 = fmin(t_first.lo, t_first.hi), out4 = fmax(t_last.lo, t_last.hi);
   const float t0 = fmin(fmin(in4.x, in4.y), fmin(in4.z, in4.w));
   const float t1 = fmax(fmax(out4.x, out4.y), fmax(out4.z, out4.w));
-  if (!(t0 <= t1)) return;
+  if (!(t0 <= t1)) return -1;
   const int step_x = grid_step(s->dx, s->ix), step_y = grid_step(s->dy, s->iy), step_z = grid_step(s->dz, s->iz);
   float t_next_x, t_next_y, t_next_z;
   int cell_x = grid_cell_at(s->ox, s->dx, s->ix, g.lower[0], g.cell[0], 0, g.res[0] - 1, step_x, t0, &t_next_x);
@@ -222,7 +225,7 @@ __attribute__((noinline)) void grid_traverse(const TraceRay* s, HitState* h, glo
     const uint begin = cell_begin[c], end = cell_begin[c + 1];
     for (uint k = begin; k < end; k += 8) {
       int found = intersect_triangle_run(lanes, g.lane_stride, lane_prims, k, (int)min(end - k, 8u), s, h);
-      if (found && RTCL_ANY_HIT) return;
+      if (found && RTCL_ANY_HIT) return c;
     }
 #ifdef RTCL_HAS_SPHERES
     for (uint k = begin; k < end; ++k) {
@@ -250,4 +253,24 @@ __attribute__((noinline)) void grid_traverse(const TraceRay* s, HitState* h, glo
       global const uchar *macro_occupied, global const float8 *occupied_boxes, global const float *lanes, \
       global const int *lane_prims, global const SphereBlock *spheres
 #define GRID_ARGS header, cell_begin, refs, macro_occupied, occupied_boxes, lanes, lane_prims, spheres
-RTCL_TRACE_KERNELS(grid, GRID_PARAMS, GRID_ARGS)
+/* Cell `cell`'s primitives against the ray; whether one hit (any hit). */
+inline int grid_leaf(int cell, const TraceRay* s, HitState* h, GRID_PARAMS) {
+  const uint begin = cell_begin[cell], end = cell_begin[cell + 1];
+  for (uint k = begin; k < end; k += 8)
+    if (intersect_triangle_run(lanes, header->lane_stride, lane_prims, k, (int)min(end - k, 8u), s, h)) return 1;
+#ifdef RTCL_HAS_SPHERES
+  int batch[8];
+  int count = 0;
+  for (uint k = begin; k < end; ++k) {
+    if (refs[k] >= 0) continue;
+    batch[count++] = ~refs[k];
+    if (count == 8) {
+      if (intersect_sphere_refs(spheres, batch, count, s, h)) return 1;
+      count = 0;
+    }
+  }
+  if (count > 0 && intersect_sphere_refs(spheres, batch, count, s, h)) return 1;
+#endif
+  return 0;
+}
+RTCL_TRACE_KERNELS_OCCLUDER_CACHE(grid, GRID_PARAMS, GRID_ARGS)

@@ -110,12 +110,14 @@ inline float octree_lattice(float p, float lower, float cell, int step) {
   return step < 0 ? ceil(x) - 1.0f : floor(x);
 }
 
-__attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, global const OctreeHeader* header,
-                                               global const ulong* codes, global const uint* leaf_begin,
-                                               global const uint* bucket_begin, global const TriangleBlock* triangles,
-                                               global const SphereBlock* spheres, global const BlockBox* boxes) {
+/* Returns the leaf (its table index) that ended an any-hit traversal, else
+ * -1. */
+__attribute__((noinline)) int octree_traverse(const TraceRay* s, HitState* h, global const OctreeHeader* header,
+                                              global const ulong* codes, global const uint* leaf_begin,
+                                              global const uint* bucket_begin, global const TriangleBlock* triangles,
+                                              global const SphereBlock* spheres, global const BlockBox* boxes) {
   const OctreeHeader g = *header;
-  if (g.leaf_count == 0) return;
+  if (g.leaf_count == 0) return -1;
   const uint side = 1u << g.depth;
   const float o[3] = {s->ox, s->oy, s->oz}, d[3] = {s->dx, s->dy, s->dz}, inv[3] = {s->ix, s->iy, s->iz};
   float t0 = s->tmin, t1 = s->tmax;
@@ -123,8 +125,8 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
   for (int a = 0; a < 3; ++a)
     if (!octree_clip_axis(o[a], d[a], inv[a], g.lower[a], octree_plane(g.lower[a], g.cell, side), &t0, &t1,
                           &step[a]))
-      return;
-  if (!(t0 <= t1)) return;
+      return -1;
+  if (!(t0 <= t1)) return -1;
   uint p[3];
   for (int a = 0; a < 3; ++a) {
     float x = octree_lattice(step[a] == 0 ? o[a] : o[a] + t0 * d[a], g.lower[a], g.cell, step[a]);
@@ -133,7 +135,7 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
   for (;;) {
     int leaf;
     int level = octree_lookup(octree_point_code(p[0], p[1], p[2]), &g, codes, bucket_begin, &leaf);
-    if (leaf >= 0 && octree_test_leaf((uint)leaf, leaf_begin, triangles, spheres, boxes, s, h)) return;
+    if (leaf >= 0 && octree_test_leaf((uint)leaf, leaf_begin, triangles, spheres, boxes, s, h)) return leaf;
     /* property 2: the cell's lower corner and side */
     const uint size = 1u << (g.depth - level);
     uint lower[3];
@@ -146,8 +148,8 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
     }
     int axis = (t_exit[0] <= t_exit[1] && t_exit[0] <= t_exit[2]) ? 0 : (t_exit[1] <= t_exit[2] ? 1 : 2);
     float te = t_exit[axis];
-    if (h->t_best <= te - fabs(te) * RTCL_SLAB_WIDEN) return;
-    if (step[axis] == 0) return;
+    if (h->t_best <= te - fabs(te) * RTCL_SLAB_WIDEN) return -1;
+    if (step[axis] == 0) return -1;
     /* the next point: one step past the exit face, the others from the exit
      * point, clamped into this cell and monotone */
     for (int a = 0; a < 3; ++a) {
@@ -159,9 +161,9 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
     }
     if (step[axis] > 0) {
       p[axis] = lower[axis] + size;
-      if (p[axis] >= side) return;
+      if (p[axis] >= side) return -1;
     } else {
-      if (lower[axis] == 0) return;
+      if (lower[axis] == 0) return -1;
       p[axis] = lower[axis] - 1u;
     }
   }
@@ -172,4 +174,8 @@ __attribute__((noinline)) void octree_traverse(const TraceRay* s, HitState* h, g
       global const uint *bucket_begin, global const TriangleBlock *triangles, global const SphereBlock *spheres, \
       global const BlockBox *boxes
 #define OCTREE_ARGS header, codes, leaf_begin, bucket_begin, triangles, spheres, boxes
-RTCL_TRACE_KERNELS(octree, OCTREE_PARAMS, OCTREE_ARGS)
+/* Leaf `leaf` (its table index) against the ray; whether it hit (any hit). */
+inline int octree_leaf(int leaf, const TraceRay* s, HitState* h, OCTREE_PARAMS) {
+  return octree_test_leaf((uint)leaf, leaf_begin, triangles, spheres, boxes, s, h);
+}
+RTCL_TRACE_KERNELS_OCCLUDER_CACHE(octree, OCTREE_PARAMS, OCTREE_ARGS)

@@ -74,14 +74,16 @@ inline int octree_ptr_occupied(global const float* rows, const TraceRay* s, floa
   return bit.s0 | bit.s1 | bit.s2 | bit.s3 | bit.s4 | bit.s5 | bit.s6 | bit.s7;
 }
 
-__attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* h,
-                                                   global const OctreePtrHeader* header,
-                                                   global const OctreeNode* nodes, global const uint* leaf_begin,
-                                                   global const TriangleBlock* triangles,
-                                                   global const SphereBlock* spheres,
-                                                   global const BlockBox* boxes) {
+/* Returns the leaf (its index into leaf_begin's pairs) that ended an
+ * any-hit traversal, else -1. */
+__attribute__((noinline)) int octree_ptr_traverse(const TraceRay* s, HitState* h,
+                                                  global const OctreePtrHeader* header,
+                                                  global const OctreeNode* nodes, global const uint* leaf_begin,
+                                                  global const TriangleBlock* triangles,
+                                                  global const SphereBlock* spheres,
+                                                  global const BlockBox* boxes) {
   const int root = header->root;
-  if (root == RTCL_CHILD_EMPTY) return;
+  if (root == RTCL_CHILD_EMPTY) return -1;
   float ta = s->tmin, tb = s->tmax;
   int step_x = octree_axis_step(s->dx, s->ix), step_y = octree_axis_step(s->dy, s->iy),
       step_z = octree_axis_step(s->dz, s->iz);
@@ -92,9 +94,9 @@ __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* 
        !octree_clip_axis(s->oy, s->dy, s->iy, header->lower[1], header->upper[1], &ta, &tb, &step_y) ||
        !octree_clip_axis(s->oz, s->dz, s->iz, header->lower[2], header->upper[2], &ta, &tb, &step_z) ||
        !(ta <= tb)))
-    return;
+    return -1;
   const int root_live = octree_ptr_occupied(&header->occupied_bounds[0][0], s, &ta, &tb);
-  if (root_live == 0) return;
+  if (root_live == 0) return -1;
   const float4 o = (float4)(s->ox, s->oy, s->oz, 0.0f), inv = (float4)(s->ix, s->iy, s->iz, 0.0f);
   int stack_ref[RTCL_OCTREE_STACK];
   float stack_ta[RTCL_OCTREE_STACK], stack_tb[RTCL_OCTREE_STACK];
@@ -143,10 +145,10 @@ __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* 
       ref = (live >> first & 1) ? node->child[first] : RTCL_CHILD_EMPTY;
       if (ref != RTCL_CHILD_EMPTY) continue;
     } else {
-      if (octree_test_leaf((uint)~ref, leaf_begin, triangles, spheres, boxes, s, h)) return;
-      if (h->t_best <= tb - fabs(tb) * RTCL_SLAB_WIDEN) return;
+      if (octree_test_leaf((uint)~ref, leaf_begin, triangles, spheres, boxes, s, h)) return ~ref;
+      if (h->t_best <= tb - fabs(tb) * RTCL_SLAB_WIDEN) return -1;
     }
-    if (sp == 0) return;
+    if (sp == 0) return -1;
     --sp;
     ref = stack_ref[sp];
     ta = stack_ta[sp];
@@ -158,4 +160,8 @@ __attribute__((noinline)) void octree_ptr_traverse(const TraceRay* s, HitState* 
   global const OctreePtrHeader *header, global const OctreeNode *nodes, global const uint *leaf_begin, \
       global const TriangleBlock *triangles, global const SphereBlock *spheres, global const BlockBox *boxes
 #define OCTREE_PTR_ARGS header, nodes, leaf_begin, triangles, spheres, boxes
-RTCL_TRACE_KERNELS(octree_ptr, OCTREE_PTR_PARAMS, OCTREE_PTR_ARGS)
+/* Leaf `leaf` against the ray; whether it hit (any hit). */
+inline int octree_ptr_leaf(int leaf, const TraceRay* s, HitState* h, OCTREE_PTR_PARAMS) {
+  return octree_test_leaf((uint)leaf, leaf_begin, triangles, spheres, boxes, s, h);
+}
+RTCL_TRACE_KERNELS_OCCLUDER_CACHE(octree_ptr, OCTREE_PTR_PARAMS, OCTREE_PTR_ARGS)

@@ -160,10 +160,10 @@ std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, c
                                   const AccelConfig& config = {});
 
 // Occluder runs (Accel::TraceKernels::occluder_run) of a structure whose
-// any-hit kernels have them (the BVHs, the kd-tree and the BSP): the
-// structure's `occluder_run` option when > 0, else kCpuOccluderRun on CPU
-// devices and 1 on others (a GPU needs every ray or packet as a work-item
-// of its own to fill its lanes).
+// any-hit kernels have them (the BVHs, the kd-tree, the BSP, the grid and
+// the octrees): the structure's `occluder_run` option when > 0, else
+// kCpuOccluderRun on CPU devices and 1 on others (a GPU needs every ray or
+// packet as a work-item of its own to fill its lanes).
 inline constexpr std::uint32_t kCpuOccluderRun = 16;
 std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device);
 // That option, as such structures declare it.

@@ -392,9 +392,10 @@ namespace {
 
 class GridAccel final : public Accel {
  public:
-  GridAccel(const Device& device, const Geometry& geometry, const Grid& grid, AccelStats stats,
-            const AccelConfig& config)
-      : Accel(device, "grid", {"accel/grid.cl"}, std::nullopt, primitive_defines(geometry), stats, config),
+  GridAccel(const Device& device, const Geometry& geometry, const Grid& grid, std::uint32_t occluder_run,
+            AccelStats stats, const AccelConfig& config)
+      : Accel(device, "grid", {"accel/grid.cl", 1, occluder_run_for(occluder_run, device.info())}, std::nullopt,
+              primitive_defines(geometry), stats, config),
         header_(device.upload(&grid.header, sizeof grid.header, "grid header")),
         cell_begin_(device.upload(grid.cell_begin.data(), grid.cell_begin.size() * sizeof(rtcl_u32),
                                   "grid cell offsets")),
@@ -446,7 +447,7 @@ std::unique_ptr<Accel> make_grid(const Device& device, const Geometry& geometry,
   stats.zero_area_skipped = report.zero_area_triangles;
   stats.node_count = grid.cell_count();
   stats.leaf_count = grid.blocks.triangles.size() + grid.blocks.spheres.size();
-  return std::make_unique<GridAccel>(device, geometry, grid, stats, accel_config);
+  return std::make_unique<GridAccel>(device, geometry, grid, config.occluder_run, stats, accel_config);
 }
 
 const StructureSpec& grid_structure() {
@@ -459,7 +460,8 @@ const StructureSpec& grid_structure() {
         "explicit cells per axis AxBxC, overriding lambda; auto: from lambda"},
        {"macro", OptionType::integer, static_cast<std::int64_t>(GridConfig{}.macro), 1, kMaxMacro, false,
         "macrocell side in cells: the walk crosses an empty macrocell in one step; 1: cell by cell",
-        true}}};
+        true},
+       occluder_run_option()}};
   return spec;
 }
 
@@ -469,6 +471,7 @@ std::unique_ptr<Accel> make_grid_accel(const Device& device, const Geometry& geo
   grid.lambda = o.real("lambda");
   grid.resolution = o.resolution("res");
   grid.macro = static_cast<unsigned>(o.integer("macro"));
+  grid.occluder_run = static_cast<std::uint32_t>(o.integer("occluder_run"));
   return make_grid(device, geometry, grid, config);
 }
 

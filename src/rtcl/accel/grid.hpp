@@ -52,6 +52,10 @@ struct GridConfig {
   // cell offsets or reference list would exceed it is refused before the
   // overlap pass, or as soon as the count is known.
   std::size_t max_alloc_bytes = 0;
+  // Occlusion: consecutive rays per work-item, each tested first against
+  // the cell whose triangles blocked the previous one; 1 = no such test, 0 = by device
+  // (occluder_run_for, accel.hpp).
+  std::uint32_t occluder_run = 0;
 };
 
 // The host image of what the kernel reads (kernels/shared/layouts.h).

@@ -150,9 +150,10 @@ namespace {
 
 class OctreeAccel final : public Accel {
  public:
-  OctreeAccel(const Device& device, const Geometry& geometry, const Octree& tree, AccelStats stats,
-              const AccelConfig& config)
-      : Accel(device, "octree", {"accel/octree.cl"}, std::nullopt, primitive_defines(geometry), stats, config),
+  OctreeAccel(const Device& device, const Geometry& geometry, const Octree& tree, std::uint32_t occluder_run,
+              AccelStats stats, const AccelConfig& config)
+      : Accel(device, "octree", {"accel/octree.cl", 1, occluder_run_for(occluder_run, device.info())}, std::nullopt,
+              primitive_defines(geometry), stats, config),
         header_(device.upload(&tree.header, sizeof tree.header, "octree header")),
         codes_(tree.codes.empty() ? device.upload(&kNoCode, sizeof kNoCode, "octree codes")
                                   : device.upload(tree.codes.data(), tree.codes.size() * sizeof(std::uint64_t),
@@ -191,7 +192,7 @@ std::unique_ptr<Accel> make_octree(const Device& device, const Geometry& geometr
   stats.device_bytes = tree.bytes();
   stats.node_count = tree.node_count;
   stats.leaf_count = tree.blocks.triangles.size() + tree.blocks.spheres.size();
-  return std::make_unique<OctreeAccel>(device, geometry, tree, stats, accel_config);
+  return std::make_unique<OctreeAccel>(device, geometry, tree, config.occluder_run, stats, accel_config);
 }
 
 const StructureSpec& octree_structure() {

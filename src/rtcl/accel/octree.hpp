@@ -35,6 +35,10 @@ struct OctreeConfig {
   bool buckets = true;
   // The largest buffer the device can allocate (0: no limit).
   std::size_t max_alloc_bytes = 0;
+  // Occlusion: consecutive rays per work-item, each tested first against
+  // the leaf that blocked the previous one; 1 = no such test, 0 = by device
+  // (occluder_run_for, accel.hpp).
+  std::uint32_t occluder_run = 0;
 };
 
 // The host image of what the kernel reads (OctreeHeader contract).

@@ -169,6 +169,7 @@ std::vector<OptionSpec> octree_options(int max_depth, int depth, std::size_t lea
        "references per primitive the tree may hold: splits past it are not made (bounds memory where surfaces "
        "meet along a line or at a point)"}};
   out.insert(out.end(), extra.begin(), extra.end());
+  out.push_back(occluder_run_option());
   return out;
 }
 

@@ -140,6 +140,7 @@ void read_octree_options(const AccelOptions& o, Config* config) {
   config->max_depth = static_cast<int>(o.integer("depth"));
   config->leaf_size = static_cast<std::size_t>(o.integer("leaf_size"));
   config->ref_budget = o.real("ref_budget");
+  config->occluder_run = static_cast<std::uint32_t>(o.integer("occluder_run"));
 }
 // The common part of a structure's config, for build_octree_nodes.
 template <class Config>

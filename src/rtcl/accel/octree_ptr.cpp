@@ -95,9 +95,9 @@ std::vector<std::string> ptr_defines(const Geometry& geometry, const OctreePtr& 
 class OctreePtrAccel final : public Accel {
  public:
   OctreePtrAccel(const Device& device, const Geometry& geometry, std::string name, const OctreePtr& tree,
-                 AccelStats stats, const AccelConfig& config)
-      : Accel(device, std::move(name), {"accel/octree_ptr.cl"}, std::nullopt, ptr_defines(geometry, tree), stats,
-              config),
+                 std::uint32_t occluder_run, AccelStats stats, const AccelConfig& config)
+      : Accel(device, std::move(name), {"accel/octree_ptr.cl", 1, occluder_run_for(occluder_run, device.info())},
+              std::nullopt, ptr_defines(geometry, tree), stats, config),
         header_(device.upload(&tree.header, sizeof tree.header, "octree header")),
         nodes_(tree.nodes.empty() ? device.upload(&kNoNode, sizeof kNoNode, "octree nodes")
                                   : device.upload(tree.nodes.data(), tree.nodes.size() * sizeof(OctreeNode),
@@ -126,18 +126,19 @@ class OctreePtrAccel final : public Accel {
 }  // namespace
 
 std::unique_ptr<Accel> make_octree_ptr_from(const Device& device, const Geometry& geometry, std::string name,
-                                            const OctreePtr& tree, AccelStats stats, const AccelConfig& config) {
+                                            const OctreePtr& tree, std::uint32_t occluder_run, AccelStats stats,
+                                            const AccelConfig& config) {
   stats.device_bytes = tree.bytes();
   stats.node_count = tree.nodes.size();
   stats.leaf_count = tree.blocks.triangles.size() + tree.blocks.spheres.size();
-  return std::make_unique<OctreePtrAccel>(device, geometry, std::move(name), tree, stats, config);
+  return std::make_unique<OctreePtrAccel>(device, geometry, std::move(name), tree, occluder_run, stats, config);
 }
 
 std::unique_ptr<Accel> make_octree_ptr(const Device& device, const Geometry& geometry, const OctreePtrConfig& config,
                                        const AccelConfig& accel_config) {
   AccelStats stats;
   OctreePtr tree = timed_octree_build(device, geometry, config, build_octree_ptr, &stats);
-  return make_octree_ptr_from(device, geometry, "octree-ptr", tree, stats, accel_config);
+  return make_octree_ptr_from(device, geometry, "octree-ptr", tree, config.occluder_run, stats, accel_config);
 }
 
 const StructureSpec& octree_ptr_structure() {

@@ -6,6 +6,7 @@
 // at the centre) and octree-r (src/rtcl/accel/octree_r.cpp).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,6 +30,10 @@ struct OctreePtrConfig {
   // References per stored primitive the tree may hold (OctreeBuildConfig).
   double ref_budget = 16.0;
   std::size_t max_alloc_bytes = 0;
+  // Occlusion: consecutive rays per work-item, each tested first against
+  // the leaf that blocked the previous one; 1 = no such test, 0 = by device
+  // (occluder_run_for, accel.hpp).
+  std::uint32_t occluder_run = 0;
 };
 
 // The host image of what the kernel reads (OctreeNode, OctreePtrHeader).
@@ -57,9 +62,10 @@ OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const
 OctreePtr build_octree_ptr(const Geometry& geometry, const OctreePtrConfig& config = {});
 
 // Uploads a pointer octree as the structure `name`; stats.build_ms is the
-// caller's.
+// caller's; occluder_run as OctreePtrConfig's.
 std::unique_ptr<Accel> make_octree_ptr_from(const Device& device, const Geometry& geometry, std::string name,
-                                            const OctreePtr& tree, AccelStats stats, const AccelConfig& config);
+                                            const OctreePtr& tree, std::uint32_t occluder_run, AccelStats stats,
+                                            const AccelConfig& config);
 
 const StructureSpec& octree_ptr_structure();
 

@@ -84,7 +84,7 @@ std::unique_ptr<Accel> make_octree_r(const Device& device, const Geometry& geome
                                      const AccelConfig& accel_config) {
   AccelStats stats;
   OctreePtr tree = timed_octree_build(device, geometry, config, build_octree_r, &stats);
-  return make_octree_ptr_from(device, geometry, "octree-r", tree, stats, accel_config);
+  return make_octree_ptr_from(device, geometry, "octree-r", tree, config.occluder_run, stats, accel_config);
 }
 
 const StructureSpec& octree_r_structure() {

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -31,6 +32,10 @@ struct OctreeRConfig {
   // when it lowers the estimated cost (OctreeBuildConfig::split_cost).
   double traversal_cost = 1.0;
   std::size_t max_alloc_bytes = 0;
+  // Occlusion: consecutive rays per work-item, each tested first against
+  // the leaf that blocked the previous one; 1 = no such test, 0 = by device
+  // (occluder_run_for, accel.hpp).
+  std::uint32_t occluder_run = 0;
 };
 
 // The plane on one axis of the node box [lo, hi] (the other axes' extents
