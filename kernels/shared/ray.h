@@ -241,16 +241,15 @@ inline int rtcl_lane_of(float8 a, float m) {
   return mask ? 31 - (int)clz(mask & -mask) : 0;
 }
 
-inline float rtcl_lane(float8 a, int i) {
-  float lanes[8];
-  vstore8(a, 0, lanes);
-  return lanes[i];
+/* Lane i (0..7) of a: the other lanes masked to zero and the eight OR-ed
+ * together, in registers (bit for bit the lane). */
+inline int rtcl_lane_i(int8 a, int i) {
+  int8 m = a & ((int8)(0, 1, 2, 3, 4, 5, 6, 7) == (int8)(i));
+  int4 o4 = m.lo | m.hi;
+  int2 o2 = o4.lo | o4.hi;
+  return o2.lo | o2.hi;
 }
 
-inline int rtcl_lane_i(int8 a, int i) {
-  int lanes[8];
-  vstore8(a, 0, lanes);
-  return lanes[i];
-}
+inline float rtcl_lane(float8 a, int i) { return as_float(rtcl_lane_i(as_int8(a), i)); }
 
 #endif
