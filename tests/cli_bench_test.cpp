@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <set>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -28,7 +29,24 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
   nlohmann::json json = nlohmann::json::parse(read_text(dir.file("out/bench.json")));
   EXPECT_EQ(json["schema"], "rtcl-bench/1");
   EXPECT_TRUE(json["rtcl"]["commit"].is_string());
-  EXPECT_TRUE(json["host"]["cpu"].is_string());
+  ASSERT_TRUE(json["host"]["cpu"].is_string());
+  {
+    // the host CPU told apart from others of its model name: family, model
+    // and widest vector extension, as the first processor's /proc/cpuinfo
+    // entry gives them
+    const std::string cpu = json["host"]["cpu"];
+    std::istringstream cpuinfo(read_text("/proc/cpuinfo"));
+    std::string line, family, flags;
+    while (std::getline(cpuinfo, line) && !line.empty()) {
+      if (line.rfind("cpu family", 0) == 0) family = line.substr(line.find(':') + 2);
+      if (line.rfind("flags", 0) == 0) flags = line + " ";
+    }
+    if (!family.empty()) EXPECT_NE(cpu.find("family " + family + " model "), std::string::npos) << cpu;
+    if (flags.find(" avx512f ") != std::string::npos)
+      EXPECT_NE(cpu.find("AVX-512"), std::string::npos) << cpu;
+    else if (flags.find(" avx2 ") != std::string::npos)
+      EXPECT_NE(cpu.find("AVX2"), std::string::npos) << cpu;
+  }
   ASSERT_EQ(json["devices"].size(), 1u);
   EXPECT_TRUE(json["devices"][0]["driver"].is_string());
   EXPECT_EQ(json["options"]["repeat"], 2);

@@ -59,15 +59,33 @@ std::vector<std::string> default_accels() {
   return out;
 }
 
+// The host CPU as results from several machines need it told apart: the
+// first processor's model name, its family and model numbers (one model
+// name can cover several generations: "AMD EPYC" is both a Zen 3 and a
+// Zen 4) and its widest x86 vector extension (PoCL's code, and with it the
+// ratios to Embree, differ between AVX2 and AVX-512), e.g. "AMD EPYC
+// (family 25 model 1, AVX2)".
 std::string host_cpu() {
   std::ifstream cpuinfo("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(cpuinfo, line))
-    if (line.rfind("model name", 0) == 0) {
-      std::size_t colon = line.find(':');
-      if (colon != std::string::npos) return line.substr(line.find_first_not_of(' ', colon + 1));
-    }
-  return "unknown";
+  std::string line, name, family, model, flags;
+  auto value = [&line] {
+    std::size_t colon = line.find(':');
+    std::size_t first = colon == std::string::npos ? std::string::npos : line.find_first_not_of(' ', colon + 1);
+    return first == std::string::npos ? std::string() : line.substr(first);
+  };
+  while (std::getline(cpuinfo, line) && !line.empty()) {
+    if (line.rfind("model name", 0) == 0) name = value();
+    else if (line.rfind("model", 0) == 0) model = value();
+    else if (line.rfind("cpu family", 0) == 0) family = value();
+    else if (line.rfind("flags", 0) == 0) flags = " " + value() + " ";
+  }
+  if (name.empty()) return "unknown";
+  std::string isa = flags.find(" avx512f ") != std::string::npos ? "AVX-512"
+                    : flags.find(" avx2 ") != std::string::npos  ? "AVX2"
+                                                                  : "";
+  std::string detail = family.empty() ? "" : "family " + family + " model " + model;
+  if (!isa.empty()) detail += (detail.empty() ? "" : ", ") + isa;
+  return detail.empty() ? name : name + " (" + detail + ")";
 }
 
 std::string utc_now() {

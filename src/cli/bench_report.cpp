@@ -161,8 +161,8 @@ const BenchCell* find_cell(const BenchRun& run, std::size_t device, const std::s
 }  // namespace
 
 std::string bench_markdown(const BenchRun& run) {
-  std::string md = "rtcl " + run.rtcl_commit + ", " + run.host_cpu + " (" + std::to_string(run.host_threads) +
-                   " threads), " + std::to_string(run.size) + "x" + std::to_string(run.size) +
+  std::string md = "rtcl " + run.rtcl_commit + ", " + run.host_cpu + ", " + std::to_string(run.host_threads) +
+                   " threads, " + std::to_string(run.size) + "x" + std::to_string(run.size) +
                    " rays per primary set, median (min - max) Mrays/s of " + std::to_string(run.repeat) +
                    " kernel launches after a warm-up (OpenCL event times), precision " + run.precision +
                    "; build: host ms; B/prim: device bytes per primitive; check: rays agreeing with brute force" +
