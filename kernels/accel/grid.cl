@@ -164,6 +164,19 @@ inline int grid_entry_cell(float o, float d, float inv, float lower, float cell,
 /* Returns the cell (its index) whose triangles ended an any-hit traversal,
  * else -1 (also when a batch of spheres, gathered over several cells, ended
  * it). */
+/* The reference lanes [begin, end) of one cell, eight triangles a run,
+ * against the ray; whether one hit (at any hit the first run that hits
+ * ends the test). */
+inline int grid_cell_triangles(global const float* lanes, int lane_stride, global const int* lane_prims, uint begin,
+                               uint end, const TraceRay* s, HitState* h) {
+  int found = 0;
+  for (uint k = begin; k < end; k += 8) {
+    found |= intersect_triangle_run(lanes, lane_stride, lane_prims, k, (int)min(end - k, 8u), s, h);
+    if (found && RTCL_ANY_HIT) break;
+  }
+  return found;
+}
+
 __attribute__((noinline)) int grid_traverse(const TraceRay* s, HitState* h, global const GridHeader* header,
                                             global const uint* cell_begin, global const int* refs,
                                             global const uchar* macro_occupied,
@@ -223,10 +236,7 @@ __attribute__((noinline)) int grid_traverse(const TraceRay* s, HitState* h, glob
       continue;
     }
     const uint begin = cell_begin[c], end = cell_begin[c + 1];
-    for (uint k = begin; k < end; k += 8) {
-      int found = intersect_triangle_run(lanes, g.lane_stride, lane_prims, k, (int)min(end - k, 8u), s, h);
-      if (found && RTCL_ANY_HIT) return c;
-    }
+    if (grid_cell_triangles(lanes, g.lane_stride, lane_prims, begin, end, s, h) && RTCL_ANY_HIT) return c;
 #ifdef RTCL_HAS_SPHERES
     for (uint k = begin; k < end; ++k) {
       int r = refs[k];
@@ -256,8 +266,7 @@ __attribute__((noinline)) int grid_traverse(const TraceRay* s, HitState* h, glob
 /* Cell `cell`'s primitives against the ray; whether one hit (any hit). */
 inline int grid_leaf(int cell, const TraceRay* s, HitState* h, GRID_PARAMS) {
   const uint begin = cell_begin[cell], end = cell_begin[cell + 1];
-  for (uint k = begin; k < end; k += 8)
-    if (intersect_triangle_run(lanes, header->lane_stride, lane_prims, k, (int)min(end - k, 8u), s, h)) return 1;
+  if (grid_cell_triangles(lanes, header->lane_stride, lane_prims, begin, end, s, h)) return 1;
 #ifdef RTCL_HAS_SPHERES
   int batch[8];
   int count = 0;

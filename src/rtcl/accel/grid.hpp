@@ -53,8 +53,8 @@ struct GridConfig {
   // overlap pass, or as soon as the count is known.
   std::size_t max_alloc_bytes = 0;
   // Occlusion: consecutive rays per work-item, each tested first against
-  // the cell whose triangles blocked the previous one; 1 = no such test, 0 = by device
-  // (occluder_run_for, accel.hpp).
+  // the cell whose triangles blocked the previous one; 1 = no such test,
+  // 0 = by device (occluder_run_for, accel.hpp).
   std::uint32_t occluder_run = 0;
 };
 
