@@ -17,7 +17,10 @@
 //
 // Environment: RTCL_SCENES_DIR; AB_PRESPLIT: values of the bvh's presplit
 // option, comma-separated (default 0); with several, each is a version of
-// rtcl's build of its own row, all in every round, the order rotated.
+// rtcl's build of its own row, all in every round, the order rotated;
+// AB_THREADS: the host threads of both builders (default every hardware
+// thread; rtcl's validate always uses them all), e.g. 1 to compare the
+// builders' serial work.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -87,11 +90,19 @@ int run(int argc, char** argv) {
   const std::vector<std::string> scenes = split(argv[1]);
   const int rounds = parse_rounds(argv[2]);
   const std::string scenes_dir = scenes_dir_or(RTCL_BUILD_AB_SCENES_DIR);
-  const unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  const char* threads_env = std::getenv("AB_THREADS");
+  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  if (threads_env && *threads_env) {
+    char* end = nullptr;
+    const long value = std::strtol(threads_env, &end, 10);
+    if (*end || value < 1 || value > 1024) throw Error(std::string("AB_THREADS: '") + threads_env + "' is not a count of 1..1024");
+    threads = static_cast<unsigned>(value);
+  }
   std::vector<BvhConfig> configs;  // the "bvh" structure's defaults (SAH on all hardware threads), presplit apart
   const char* presplit_env = std::getenv("AB_PRESPLIT");
   for (const std::string& value : split(presplit_env && *presplit_env ? presplit_env : "0")) {
     BvhConfig config;
+    config.sah.thread_count = threads;
     char* end = nullptr;
     config.presplit = std::strtof(value.c_str(), &end);
     if (end == value.c_str() || *end || !(config.presplit >= 0.0f))
