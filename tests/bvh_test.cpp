@@ -521,7 +521,8 @@ TEST(Bvh, FlattenRejectsMismatchesOnEveryThread) {
 
   // Every box the scene's, so that no box check objects to the moved id.
   BuildTree twice = tree;
-  for (BuildNode& n : twice.nodes) n.bounds = g.bounds();
+  const Aabb scene = g.bounds();
+  for (BuildNode& n : twice.nodes) n.bounds = scene;
   auto [first, at] = ends(twice);
   twice.prims[at] = first;
   std::string error = flatten_error(twice, g, 2);
