@@ -1,5 +1,6 @@
 // rtcl_build_ab: rtcl's BVH build against Embree's default build, both on
-// all host threads, alternating in one process, scene by scene.
+// the same host threads (all of them, or AB_THREADS), alternating in one
+// process, scene by scene.
 //
 //   rtcl_build_ab SCENES ROUNDS
 //   e.g. rtcl_build_ab bunny,dragon,soup:1000000 7
@@ -95,10 +96,11 @@ int run(int argc, char** argv) {
   if (threads_env && *threads_env) {
     char* end = nullptr;
     const long value = std::strtol(threads_env, &end, 10);
-    if (*end || value < 1 || value > 1024) throw Error(std::string("AB_THREADS: '") + threads_env + "' is not a count of 1..1024");
+    if (*end || value < 1 || value > 1024)
+      throw Error(std::string("AB_THREADS: '") + threads_env + "' is not a count of 1..1024");
     threads = static_cast<unsigned>(value);
   }
-  std::vector<BvhConfig> configs;  // the "bvh" structure's defaults (SAH on all hardware threads), presplit apart
+  std::vector<BvhConfig> configs;  // the "bvh" structure's defaults (SAH on `threads`), presplit apart
   const char* presplit_env = std::getenv("AB_PRESPLIT");
   for (const std::string& value : split(presplit_env && *presplit_env ? presplit_env : "0")) {
     BvhConfig config;

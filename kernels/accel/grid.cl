@@ -161,9 +161,6 @@ inline int grid_entry_cell(float o, float d, float inv, float lower, float cell,
   return grid_cell_at(o, d, inv, lower, cell, macro << shift, min((macro + 1) << shift, res) - 1, step, t, t_next);
 }
 
-/* Returns the cell (its index) whose triangles ended an any-hit traversal,
- * else -1 (also when a batch of spheres, gathered over several cells, ended
- * it). */
 /* The reference lanes [begin, end) of one cell, eight triangles a run,
  * against the ray; whether one hit (at any hit the first run that hits
  * ends the test). */
@@ -177,6 +174,9 @@ inline int grid_cell_triangles(global const float* lanes, int lane_stride, globa
   return found;
 }
 
+/* Returns the cell (its index) whose triangles ended an any-hit traversal,
+ * else -1 (also when a batch of spheres, gathered over several cells, ended
+ * it). */
 __attribute__((noinline)) int grid_traverse(const TraceRay* s, HitState* h, global const GridHeader* header,
                                             global const uint* cell_begin, global const int* refs,
                                             global const uchar* macro_occupied,
