@@ -3,10 +3,12 @@
 // pointing at --help) and an exit code from exit_codes.hpp.
 #pragma once
 
-#include <CLI/CLI.hpp>
-
 #include "exit_codes.hpp"
 #include "rtcl/error.hpp"
+
+namespace CLI {
+class App;
+}
 
 namespace rtcl::cli {
 
