@@ -417,6 +417,33 @@ TEST(Bvh, IsRegistered) {
   EXPECT_NE(std::find(names.begin(), names.end(), "bvh-ploc"), names.end());
 }
 
+// The SAH builder tests the boxes in its parallel pass over them: the error
+// names the first bad box in input order, whichever thread met it.
+TEST(Bvh, SahBuilderNamesTheFirstBadBoxOnEveryThread) {
+  const std::size_t n = 40000;
+  std::vector<Aabb> bounds(n);
+  std::vector<std::uint32_t> ids(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float x = static_cast<float>(i);
+    bounds[i] = Aabb{{x, 0, 0}, {x + 1, 1, 1}};
+    ids[i] = static_cast<std::uint32_t>(i + 7);
+  }
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  const std::pair<int, float> corruptions[] = {{0, -inf}, {4, inf}, {2, nan}, {5, -1e30f}};  // bound index, value
+  for (const auto& [bound, value] : corruptions)
+    for (unsigned threads : {1u, 2u}) {
+      std::vector<Aabb> bad = bounds;
+      for (std::size_t i : {std::size_t(30001), std::size_t(35000)})
+        (bound < 3 ? bad[i].lower : bad[i].upper)[bound % 3] = value;
+      try {
+        build_sah(bad, ids, {.thread_count = threads});
+        ADD_FAILURE() << "bound " << bound << " = " << value << " accepted";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("the box of primitive 30008 has"), std::string::npos) << e.what();
+      }
+    }
+}
+
 TEST(Bvh, BadBuilderInputIsAnError) {
   std::vector<Aabb> bounds(3, Aabb{{0, 0, 0}, {1, 1, 1}});
   std::vector<std::uint32_t> ids = {0, 1};

@@ -56,19 +56,26 @@ BuildTree join(BuildTree a, BuildTree b) {
   return out;
 }
 
-void check_builder_input(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const char* builder) {
+void check_builder_sizes(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const char* builder) {
   if (bounds.size() != ids.size())
     throw Error(std::string(builder) + ": " + std::to_string(bounds.size()) + " boxes but " +
                 std::to_string(ids.size()) + " primitive ids");
   if (bounds.size() > 0x7fffffffu)
     throw Error(std::string(builder) + ": " + std::to_string(bounds.size()) + " primitives exceed 2^31 - 1");
+}
+
+Error builder_box_error(std::uint32_t id, const char* builder) {
+  return Error(std::string(builder) + ": the box of primitive " + std::to_string(id) +
+               " has a NaN or infinite coordinate or lower > upper");
+}
+
+void check_builder_input(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const char* builder) {
+  check_builder_sizes(bounds, ids, builder);
   for (std::size_t i = 0; i < bounds.size(); ++i) {
     const Aabb& b = bounds[i];
     bool ok = true;
     for (int a = 0; a < 3; ++a) ok = ok && std::isfinite(b.lower[a]) && std::isfinite(b.upper[a]) && b.lower[a] <= b.upper[a];
-    if (!ok)
-      throw Error(std::string(builder) + ": the box of primitive " + std::to_string(ids[i]) +
-                  " has a NaN or infinite coordinate or lower > upper");
+    if (!ok) throw builder_box_error(ids[i], builder);
   }
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rtcl/bounds/aabb.hpp"
+#include "rtcl/error.hpp"
 
 namespace rtcl {
 
@@ -40,6 +41,11 @@ BuildTree join(BuildTree a, BuildTree b);
 // Throws Error (naming `builder`) unless bounds and ids have the same length
 // and every box is finite with lower <= upper.
 void check_builder_input(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const char* builder);
+// The first half of check_builder_input: the lengths alone (a builder that
+// tests the boxes in its own pass over them, with builder_box_error).
+void check_builder_sizes(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const char* builder);
+// check_builder_input's error for the box of primitive `id`.
+Error builder_box_error(std::uint32_t id, const char* builder);
 
 // "" when the tree is well formed for these inputs: every id of `ids` sits in
 // exactly one leaf, every leaf has 1..max_leaf primitives, every node is

@@ -230,42 +230,53 @@ class Flattener {
 
   // The top's and the parts' nodes and sources in one tree: the top's
   // first, then each part's in the order of `deferred`, their indices
-  // moved by what comes before them.
+  // moved by what comes before them. Parts are copied on whichever thread
+  // is free.
   void assemble(WalkOutput top, const std::vector<Deferred>& deferred, std::vector<WalkOutput>& parts) {
-    std::size_t nodes = top.nodes.size(), triangles = top.triangle_sources.size(), spheres = top.sphere_sources.size();
-    for (const WalkOutput& part : parts) {
-      nodes += part.nodes.size();
-      triangles += part.triangle_sources.size();
-      spheres += part.sphere_sources.size();
-    }
-    if (nodes > 0x7fffffffu) fail("too many nodes");
-    out_.nodes = std::move(top.nodes);
-    out_.nodes.reserve(nodes);
-    triangle_sources_ = std::move(top.triangle_sources);
-    triangle_sources_.reserve(triangles);
-    sphere_sources_ = std::move(top.sphere_sources);
-    sphere_sources_.reserve(spheres);
+    struct Offsets {
+      std::size_t nodes, triangles, spheres;
+    };
+    std::vector<Offsets> offsets(parts.size());
+    Offsets end{top.nodes.size(), top.triangle_sources.size(), top.sphere_sources.size()};
     out_.stack_size = top.stack_size;
     out_.depth = top.depth;
     for (std::size_t k = 0; k < parts.size(); ++k) {
-      WalkOutput& part = parts[k];
-      const auto node_offset = static_cast<std::uint32_t>(out_.nodes.size());
-      const auto triangle_offset = static_cast<std::uint32_t>(triangle_sources_.size());
-      const auto sphere_offset = static_cast<std::uint32_t>(sphere_sources_.size());
-      out_.nodes[deferred[k].parent].child[deferred[k].lane] = static_cast<rtcl_i32>(node_offset);
-      for (Bvh8Node& node : part.nodes) {
+      offsets[k] = end;
+      end.nodes += parts[k].nodes.size();
+      end.triangles += parts[k].triangle_sources.size();
+      end.spheres += parts[k].sphere_sources.size();
+      out_.stack_size = std::max(out_.stack_size, parts[k].stack_size);
+      out_.depth = std::max(out_.depth, parts[k].depth);
+    }
+    if (end.nodes > 0x7fffffffu) fail("too many nodes");
+    out_.nodes = std::move(top.nodes);
+    out_.nodes.resize(end.nodes);
+    triangle_sources_ = std::move(top.triangle_sources);
+    triangle_sources_.resize(end.triangles);
+    sphere_sources_ = std::move(top.sphere_sources);
+    sphere_sources_.resize(end.spheres);
+    for (std::size_t k = 0; k < parts.size(); ++k)
+      out_.nodes[deferred[k].parent].child[deferred[k].lane] = static_cast<rtcl_i32>(offsets[k].nodes);
+    for_each_index(parts.size(), threads_, [&](std::size_t k) {
+      const WalkOutput& part = parts[k];
+      const Offsets& at = offsets[k];
+      const auto node_offset = static_cast<rtcl_i32>(at.nodes);
+      const auto triangle_offset = static_cast<std::uint32_t>(at.triangles);
+      const auto sphere_offset = static_cast<std::uint32_t>(at.spheres);
+      Bvh8Node* to = out_.nodes.data() + at.nodes;
+      for (Bvh8Node node : part.nodes) {
         for (rtcl_i32& c : node.child)
           if (c >= 0)
-            c += static_cast<rtcl_i32>(node_offset);
+            c += node_offset;
           else if (c != RTCL_CHILD_EMPTY)
             c = rebase_leaf(c, triangle_offset, sphere_offset);
-        out_.nodes.push_back(node);
+        *to++ = node;
       }
-      triangle_sources_.insert(triangle_sources_.end(), part.triangle_sources.begin(), part.triangle_sources.end());
-      sphere_sources_.insert(sphere_sources_.end(), part.sphere_sources.begin(), part.sphere_sources.end());
-      out_.stack_size = std::max(out_.stack_size, part.stack_size);
-      out_.depth = std::max(out_.depth, part.depth);
-    }
+      std::copy(part.triangle_sources.begin(), part.triangle_sources.end(),
+                triangle_sources_.begin() + static_cast<std::ptrdiff_t>(at.triangles));
+      std::copy(part.sphere_sources.begin(), part.sphere_sources.end(),
+                sphere_sources_.begin() + static_cast<std::ptrdiff_t>(at.spheres));
+    });
   }
 
   void visit(std::uint32_t n) {

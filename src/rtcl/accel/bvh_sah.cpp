@@ -136,6 +136,8 @@ struct Range {
 
 class SahBuilder {
  public:
+  // Throws check_builder_input's error for the first invalid box (the
+  // boxes are tested in the constructor's parallel pass over them).
   SahBuilder(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config)
       : config_(config),
         refs_(std::make_unique_for_overwrite<PrimRef[]>(bounds.size())),
@@ -148,8 +150,12 @@ class SahBuilder {
       Box box = Box::empty(), centres = Box::empty();
       for (std::size_t i = begin; i < end; ++i) {
         const Aabb& b = bounds[i];
-        refs_[i].box = {Float4{b.lower.x, b.lower.y, b.lower.z, 0.0f},
-                        Float4{b.upper.x, b.upper.y, b.upper.z, std::bit_cast<float>(ids[i])}};
+        const Float4 lo = {b.lower.x, b.lower.y, b.lower.z, 0.0f}, hi = {b.upper.x, b.upper.y, b.upper.z, 0.0f};
+        // finite with lo <= hi (false for NaN) on every axis
+        const Int4 ok = (lo > -kInf) & (hi < kInf) & (lo <= hi);
+        if (!(ok[0] & ok[1] & ok[2])) throw builder_box_error(ids[i], "SAH builder");
+        refs_[i].box = {lo, hi};
+        refs_[i].box.hi[3] = std::bit_cast<float>(ids[i]);
         box.grow(refs_[i].box);
         centres.grow_point(refs_[i].centre());
       }
@@ -172,7 +178,10 @@ class SahBuilder {
     for (std::thread& helper : helpers) helper.join();
     assemble(tree.nodes);
     tree.prims.resize(ref_count_);
-    for (std::size_t i = 0; i < ref_count_; ++i) tree.prims[i] = refs_[i].id();
+    for_each_part(ref_count_, part_count(ref_count_, thread_count_, config_.parallel_min_primitives),
+                  [&](unsigned, std::size_t begin, std::size_t end) {
+                    for (std::size_t i = begin; i < end; ++i) tree.prims[i] = refs_[i].id();
+                  });
     return tree;
   }
 
@@ -475,7 +484,7 @@ class SahBuilder {
 
   // The subtrees' nodes in one array, subtree 0's first: each child index
   // rebased onto its own subtree's place, a subtree reference onto that
-  // subtree's root.
+  // subtree's root. Subtrees are copied on whichever thread is free.
   void assemble(std::vector<BuildNode>& out) const {
     std::vector<std::uint32_t> first(subtrees_.size());
     std::size_t total = 0;
@@ -484,7 +493,7 @@ class SahBuilder {
       total += subtrees_[k]->size();
     }
     out.resize(total);
-    for (std::size_t k = 0; k < subtrees_.size(); ++k) {
+    for_each_index(subtrees_.size(), thread_count_, [&](std::size_t k) {
       BuildNode* to = out.data() + first[k];
       for (const BuildNode& n : *subtrees_[k]) {
         *to = n;
@@ -492,7 +501,7 @@ class SahBuilder {
           for (std::uint32_t& c : to->child) c = c & kSubtreeRef ? first[c & ~kSubtreeRef] : first[k] + c;
         ++to;
       }
-    }
+    });
   }
 
   struct Task {
@@ -529,7 +538,7 @@ BuildTree build_sah(std::span<const Aabb> bounds, std::span<const std::uint32_t>
     throw Error("SAH builder: node_cost must be finite and >= 0");
   if (config.max_sah_depth > 1024)
     throw Error("SAH builder: max_sah_depth " + std::to_string(config.max_sah_depth) + " is above 1024");
-  check_builder_input(bounds, ids, "SAH builder");
+  check_builder_sizes(bounds, ids, "SAH builder");
   return SahBuilder(bounds, ids, config).run();
 }
 
