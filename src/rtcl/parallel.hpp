@@ -10,6 +10,8 @@
 #include <thread>
 #include <vector>
 
+#include "rtcl/thread_pool.hpp"
+
 namespace rtcl {
 
 // Threads for a pass over count items: at most `threads` (0 = every
@@ -21,32 +23,14 @@ inline unsigned part_count(std::size_t count, unsigned threads, std::size_t min_
 }
 
 // Calls fn(part, begin, end) for parts contiguous ranges covering [0,
-// count) in order, part 0 on the calling thread and each other on its own
-// thread. After all have returned, rethrows the exception of the lowest part
-// that threw, so that an error names the first bad item as a serial loop
-// would (each part stops at its first).
+// count) in order, part 0 on the calling thread and each other on a thread of
+// its own (run_jobs). After all have returned, rethrows the exception of the
+// lowest part that threw, so that an error names the first bad item as a
+// serial loop would (each part stops at its first).
 template <class Fn>
 void for_each_part(std::size_t count, unsigned parts, Fn&& fn) {
   parts = std::max(parts, 1u);
-  if (parts == 1) {
-    fn(0u, std::size_t(0), count);
-    return;
-  }
-  std::vector<std::exception_ptr> errors(parts);
-  auto run = [&](unsigned part) {
-    try {
-      fn(part, count * part / parts, count * (part + 1) / parts);
-    } catch (...) {
-      errors[part] = std::current_exception();
-    }
-  };
-  std::vector<std::thread> helpers;
-  helpers.reserve(parts - 1);
-  for (unsigned part = 1; part < parts; ++part) helpers.emplace_back(run, part);
-  run(0);
-  for (std::thread& helper : helpers) helper.join();
-  for (const std::exception_ptr& e : errors)
-    if (e) std::rethrow_exception(e);
+  run_jobs(parts, [&](unsigned part) { fn(part, count * part / parts, count * (part + 1) / parts); });
 }
 
 // Calls fn(k) for every k in [0, count), each on whichever of `threads`
@@ -56,7 +40,7 @@ template <class Fn>
 void for_each_index(std::size_t count, unsigned threads, Fn&& fn) {
   std::vector<std::exception_ptr> errors(count);
   std::atomic<std::size_t> next{0};
-  auto run = [&] {
+  run_jobs(static_cast<unsigned>(std::min<std::size_t>(std::max(threads, 1u), count)), [&](unsigned) {
     for (std::size_t k; (k = next.fetch_add(1, std::memory_order_relaxed)) < count;) {
       try {
         fn(k);
@@ -64,11 +48,7 @@ void for_each_index(std::size_t count, unsigned threads, Fn&& fn) {
         errors[k] = std::current_exception();
       }
     }
-  };
-  std::vector<std::thread> helpers;
-  for (std::size_t t = 1; t < std::min<std::size_t>(std::max(threads, 1u), count); ++t) helpers.emplace_back(run);
-  run();
-  for (std::thread& helper : helpers) helper.join();
+  });
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
 }

@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "rtcl/error.hpp"
+#include "rtcl/thread_pool.hpp"
 
 namespace rtcl {
 
@@ -53,10 +54,12 @@ class BspBuilder {
     double below_budget = budget * static_cast<double>(below.size()) / both;
     double above_budget = budget * static_cast<double>(above.size()) / both;
     if (both >= kParallelMin && threads_.try_take()) {
-      std::thread worker(
-          [&] { node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget); });
-      node->above = build(above_lower, upper, std::move(above), depth + 1, above_budget);
-      worker.join();
+      run_jobs(2, [&](unsigned job) {
+        if (job == 0)
+          node->above = build(above_lower, upper, std::move(above), depth + 1, above_budget);
+        else
+          node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget);
+      });
       threads_.give_back();
     } else {
       node->below = build(lower, below_upper, std::move(below), depth + 1, below_budget);

@@ -9,6 +9,7 @@
 
 #include "rtcl/accel/bvh_sah.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/parallel.hpp"
 #include "rtcl/layouts.hpp"
 
 namespace rtcl {
@@ -151,17 +152,9 @@ class PlocBuilder {
     while (c.size() > 1) {
       const std::size_t m = c.size();
       unsigned workers = m >= config_.parallel_min_clusters ? threads_ : 1;
-      if (workers <= 1) {
-        nearest_neighbours(c, config_.search_radius, 0, m, nn);
-      } else {
-        std::vector<std::thread> pool;
-        for (unsigned w = 1; w < workers; ++w)
-          pool.emplace_back([&, w] {
-            nearest_neighbours(c, config_.search_radius, m * w / workers, m * (w + 1) / workers, nn);
-          });
-        nearest_neighbours(c, config_.search_radius, 0, m / workers, nn);
-        for (auto& t : pool) t.join();
-      }
+      for_each_part(m, workers, [&](unsigned, std::size_t begin, std::size_t end) {
+        nearest_neighbours(c, config_.search_radius, begin, end, nn);
+      });
       // Progress guarantee: inputs whose boxes all overlap alike (a fan of
       // triangles around one shared vertex) form nearest-neighbour chains
       // with a single mutual pair each, so clustering would take O(n)

@@ -13,6 +13,7 @@
 #include "rtcl/error.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/parallel.hpp"
+#include "rtcl/thread_pool.hpp"
 
 namespace rtcl {
 
@@ -172,10 +173,7 @@ class SahBuilder {
     BuildTree tree;
     if (ref_count_ == 0) return tree;
     tasks_.push_back({new_subtree(ref_count_), root_, 1});
-    std::vector<std::thread> helpers;
-    for (unsigned t = 1; t < thread_count_; ++t) helpers.emplace_back([this] { work(); });
-    work();
-    for (std::thread& helper : helpers) helper.join();
+    run_jobs(thread_count_, [this](unsigned) { work(); });
     assemble(tree.nodes);
     tree.prims.resize(ref_count_);
     for_each_part(ref_count_, part_count(ref_count_, thread_count_, config_.parallel_min_primitives),

@@ -6,10 +6,10 @@
 #include <cmath>
 #include <limits>
 #include <string>
-#include <thread>
 
 #include "rtcl/bounds/overlap.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/thread_pool.hpp"
 
 namespace rtcl {
 
@@ -296,10 +296,7 @@ Grid build_grid(const Geometry& geometry, const GridConfig& config) {
       }
     }
   };
-  std::vector<std::thread> pool;
-  for (unsigned part = 1; part < threads; ++part) pool.emplace_back(triangles, part);
-  triangles(0);
-  for (std::thread& t : pool) t.join();
+  run_jobs(threads, triangles);
   for (std::size_t j = 0; j < geometry.spheres.size(); ++j) {
     const Sphere& s = geometry.spheres[j];
     glm::dvec3 center(s.center);

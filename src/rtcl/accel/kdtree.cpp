@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "rtcl/error.hpp"
+#include "rtcl/thread_pool.hpp"
 
 namespace rtcl {
 
@@ -277,10 +278,14 @@ class ExactBuilder {
     for (auto& list : events) list.reserve(2 * refs.size());
     for (const Ref& r : refs) add_events(events, r);
     if (refs.size() >= kExactParallelMin && threads_.try_take()) {
-      std::thread y([&] { std::sort(events[1].begin(), events[1].end()); });
-      std::sort(events[0].begin(), events[0].end());
-      std::sort(events[2].begin(), events[2].end());
-      y.join();
+      run_jobs(2, [&](unsigned job) {
+        if (job == 1) {
+          std::sort(events[1].begin(), events[1].end());
+          return;
+        }
+        std::sort(events[0].begin(), events[0].end());
+        std::sort(events[2].begin(), events[2].end());
+      });
       threads_.give_back();
     } else {
       for (auto& list : events) std::sort(list.begin(), list.end());
@@ -371,12 +376,14 @@ class ExactBuilder {
     node.below = std::make_unique<KdBuildNode>();
     node.above = std::make_unique<KdBuildNode>();
     if (n >= kExactParallelMin && threads_.try_take()) {
-      std::thread worker([&] {
+      run_jobs(2, [&](unsigned job) {
+        if (job == 0) {
+          build(*node.above, above_lower, upper, std::move(above), above_path, side);
+          return;
+        }
         std::vector<std::uint8_t> own(prims_.size(), 0);
         build(*node.below, lower, below_upper, std::move(below), below_path, own);
       });
-      build(*node.above, above_lower, upper, std::move(above), above_path, side);
-      worker.join();
       threads_.give_back();
     } else {
       build(*node.below, lower, below_upper, std::move(below), below_path, side);

@@ -1,0 +1,126 @@
+#include "rtcl/thread_pool.hpp"
+
+#include <unistd.h>
+
+#include <condition_variable>
+#include <deque>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace rtcl {
+
+namespace {
+
+// One run_jobs call: its jobs 1 .. count - 1 wait in the pool's queue until
+// a thread claims them. Lives on the caller's stack; guarded by the pool's
+// mutex.
+struct Batch {
+  const std::function<void(unsigned)>* job;
+  unsigned count;
+  unsigned next;     // the next job to claim
+  unsigned running;  // jobs not yet returned, job 0 included
+  std::vector<std::exception_ptr> errors;
+  std::condition_variable finished;
+};
+
+class ThreadPool {
+ public:
+  ~ThreadPool() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+    }
+    work_.notify_all();
+    for (std::thread& t : threads_) t.join();
+  }
+
+  void run(unsigned jobs, const std::function<void(unsigned)>& job) {
+    Batch batch{&job, jobs, 1, jobs, std::vector<std::exception_ptr>(jobs), {}};
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (owner_ != getpid()) forget_threads();
+      queue_.push_back(&batch);
+      unclaimed_ += jobs - 1;
+      // every waiting job has an idle thread to take it at once
+      while (idle_ < unclaimed_) {
+        ++idle_;
+        threads_.emplace_back([this] { serve(); });
+      }
+    }
+    if (jobs > 2)
+      work_.notify_all();
+    else
+      work_.notify_one();
+    execute(batch, 0);
+    std::unique_lock<std::mutex> lock(mutex_);
+    batch.finished.wait(lock, [&] { return batch.running == 0; });
+    lock.unlock();
+    for (const std::exception_ptr& e : batch.errors)
+      if (e) std::rethrow_exception(e);
+  }
+
+ private:
+  void execute(Batch& batch, unsigned k) {
+    try {
+      (*batch.job)(k);
+    } catch (...) {
+      batch.errors[k] = std::current_exception();
+    }
+    // the batch is not touched once its caller has seen running == 0
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (--batch.running == 0) batch.finished.notify_one();
+  }
+
+  // A pool thread: runs the oldest waiting job until the pool stops.
+  void serve() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    for (;;) {
+      work_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      if (queue_.empty()) return;
+      Batch& batch = *queue_.front();
+      const unsigned k = batch.next++;
+      if (batch.next == batch.count) queue_.pop_front();
+      --unclaimed_;
+      --idle_;
+      lock.unlock();
+      execute(batch, k);
+      lock.lock();
+      ++idle_;
+    }
+  }
+
+  // In a child forked after threads were started (their handles copied, the
+  // threads themselves not): the pool starts anew, the handles let go.
+  void forget_threads() {
+    for (std::thread& t : threads_) t.detach();
+    threads_.clear();
+    queue_.clear();
+    unclaimed_ = idle_ = 0;
+    owner_ = getpid();
+  }
+
+  pid_t owner_ = getpid();  // the process whose threads threads_ holds
+  std::mutex mutex_;
+  std::condition_variable work_;  // a job is waiting, or the pool stops
+  std::deque<Batch*> queue_;      // batches with unclaimed jobs, oldest first
+  unsigned unclaimed_ = 0;        // jobs in queue_'s batches not yet claimed
+  unsigned idle_ = 0;             // pool threads not running a job
+  bool stopping_ = false;
+  std::vector<std::thread> threads_;
+};
+
+}  // namespace
+
+void run_jobs(unsigned jobs, const std::function<void(unsigned)>& job) {
+  if (jobs == 0) return;
+  if (jobs == 1) {
+    job(0);
+    return;
+  }
+  static ThreadPool pool;
+  pool.run(jobs, job);
+}
+
+}  // namespace rtcl
