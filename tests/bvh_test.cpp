@@ -442,7 +442,43 @@ TEST(Bvh, SahBuilderNamesTheFirstBadBoxOnEveryThread) {
       } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("the box of primitive 15007 has"), std::string::npos) << e.what();
       }
+      // the same boxes as references filled by the caller
+      auto refs = std::make_unique<SahRef[]>(n);
+      for (std::size_t i = 0; i < n; ++i) refs[i] = SahRef::of(bad[i], ids[i]);
+      try {
+        build_sah(std::move(refs), n, {.thread_count = threads});
+        ADD_FAILURE() << "bound " << bound << " = " << value << " accepted as a reference";
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("the box of primitive 15007 has"), std::string::npos) << e.what();
+      }
     }
+}
+
+// build_binary_bvh fills the SAH builder's references in its own pass over
+// the triangles (zero-area ones skipped in every part): the tree of the
+// stored triangles' boxes and ids given to build_sah, and of the same
+// references given to it, on one thread and on two.
+TEST(Bvh, SahOverFilledReferencesBuildsTheTreeOfTheBoxes) {
+  Geometry g = random_soup(40000, 31);
+  for (std::size_t i = 3; i < g.triangles.size(); i += 7) g.triangles[i].z = g.triangles[i].y;
+  const Inputs in = triangle_inputs(g);
+  ASSERT_LT(in.ids.size(), g.triangles.size() - g.triangles.size() / 8);
+  for (unsigned threads : {1u, 2u}) {
+    BvhConfig config;
+    config.sah.thread_count = threads;
+    std::vector<double> of_boxes, of_refs, of_geometry;
+    canonical(build_sah(in.bounds, in.ids, config.sah), 0, of_boxes);
+    auto refs = std::make_unique<SahRef[]>(in.ids.size());
+    for (std::size_t i = 0; i < in.ids.size(); ++i) refs[i] = SahRef::of(in.bounds[i], in.ids[i]);
+    canonical(build_sah(std::move(refs), in.ids.size(), config.sah), 0, of_refs);
+    std::size_t stored = 0;
+    canonical(build_binary_bvh(g, config, &stored), 0, of_geometry);
+    EXPECT_EQ(stored, in.ids.size());
+    EXPECT_TRUE(of_refs == of_boxes) << threads << " threads";
+    EXPECT_TRUE(of_geometry == of_boxes) << threads << " threads";
+  }
+  EXPECT_THROW(build_sah(nullptr, 3), Error);
+  EXPECT_EQ(build_sah(nullptr, 0).nodes.size(), 0u);
 }
 
 TEST(Bvh, BadBuilderInputIsAnError) {

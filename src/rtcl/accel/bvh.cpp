@@ -24,6 +24,35 @@ Aabb sphere_bounds(const Sphere& s) {
   return {s.center - r, s.center + r};
 }
 
+// Calls write(k, i, box) for the k-th triangle i of non-zero area (k from
+// 0 up) and its box, on the build's threads, and returns how many there
+// are: each part writes from its own first triangle on, then
+// move(from, count, to) moves each later part down over the gaps its
+// predecessors' zero-area triangles left.
+template <class Write, class Move>
+std::size_t for_each_kept_triangle(const Geometry& geometry, unsigned threads, Write write, Move move) {
+  const std::size_t triangles = geometry.triangles.size();
+  const unsigned parts = part_count(triangles, threads, kBoundsPartMin);
+  std::vector<std::size_t> part_end(parts);
+  for_each_part(triangles, parts, [&](unsigned part, std::size_t begin, std::size_t end) {
+    std::size_t out = begin;
+    for (std::size_t i = begin; i < end; ++i) {
+      const glm::uvec3& t = geometry.triangles[i];
+      const glm::vec3 &a = geometry.vertices[t.x], &b = geometry.vertices[t.y], &c = geometry.vertices[t.z];
+      if (zero_area(a, b, c)) continue;
+      write(out++, static_cast<std::uint32_t>(i), Aabb{glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))});
+    }
+    part_end[part] = out;
+  });
+  std::size_t kept = 0;
+  for (unsigned part = 0; part < parts; ++part) {
+    const std::size_t begin = triangles * part / parts, count = part_end[part] - begin;
+    if (kept != begin) move(begin, count, kept);
+    kept += count;
+  }
+  return kept;
+}
+
 BuildTree build_kind(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const BvhConfig& config) {
   if (bounds.empty()) return {};
   if (config.custom_builder) return config.custom_builder(bounds, ids);
@@ -64,44 +93,50 @@ class BvhAccel final : public Accel {
 }  // namespace
 
 BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config, std::size_t* stored) {
-  // The stored primitives (stored_primitives' ids, triangles first) and
-  // their boxes in one pass over the triangles, each part writing from its
-  // own first triangle on; parts after a zero-area triangle move down.
   const std::size_t triangles = geometry.triangles.size();
-  std::vector<std::uint32_t> ids(geometry.primitive_count());
-  std::vector<Aabb> bounds(ids.size());
-  const unsigned parts = part_count(triangles, bvh_thread_count(config), kBoundsPartMin);
-  std::vector<std::size_t> part_end(parts);
-  for_each_part(triangles, parts, [&](unsigned part, std::size_t begin, std::size_t end) {
-    std::size_t out = begin;
-    for (std::size_t i = begin; i < end; ++i) {
-      const glm::uvec3& t = geometry.triangles[i];
-      const glm::vec3 &a = geometry.vertices[t.x], &b = geometry.vertices[t.y], &c = geometry.vertices[t.z];
-      if (zero_area(a, b, c)) continue;
-      ids[out] = static_cast<std::uint32_t>(i);
-      bounds[out++] = Aabb{glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
-    }
-    part_end[part] = out;
-  });
-  std::size_t first_sphere = 0;
-  for (unsigned part = 0; part < parts; ++part) {
-    const std::size_t begin = triangles * part / parts, kept = part_end[part] - begin;
-    if (first_sphere != begin) {
-      std::copy_n(ids.begin() + static_cast<std::ptrdiff_t>(begin), kept, ids.begin() + static_cast<std::ptrdiff_t>(first_sphere));
-      std::copy_n(bounds.begin() + static_cast<std::ptrdiff_t>(begin), kept,
-                  bounds.begin() + static_cast<std::ptrdiff_t>(first_sphere));
-    }
-    first_sphere += kept;
-  }
+  std::vector<std::uint32_t> sphere_ids(geometry.spheres.size());
+  std::vector<Aabb> sphere_boxes(geometry.spheres.size());
   for (std::size_t j = 0; j < geometry.spheres.size(); ++j) {
-    ids[first_sphere + j] = static_cast<std::uint32_t>(triangles + j);
-    bounds[first_sphere + j] = sphere_bounds(geometry.spheres[j]);
+    sphere_ids[j] = static_cast<std::uint32_t>(triangles + j);
+    sphere_boxes[j] = sphere_bounds(geometry.spheres[j]);
   }
-  ids.resize(first_sphere + geometry.spheres.size());
-  if (ids.empty()) throw empty_scene_error(geometry);
-  bounds.resize(ids.size());
-  if (stored) *stored = ids.size();
-  first_sphere = presplit_triangles(geometry, ids, bounds, first_sphere, config.presplit);
+  const auto count_stored = [&](std::size_t kept) {
+    if (kept + sphere_ids.size() == 0) throw empty_scene_error(geometry);
+    if (stored) *stored = kept + sphere_ids.size();
+  };
+  if (!config.custom_builder && config.builder == BvhBuilder::sah && config.presplit <= 0.0f) {
+    // The SAH builder's own array filled here, without box and id arrays
+    // in between (README, "The SAH builder's input").
+    auto refs = std::make_unique_for_overwrite<SahRef[]>(triangles);
+    const std::size_t kept = for_each_kept_triangle(
+        geometry, bvh_thread_count(config),
+        [&](std::size_t k, std::uint32_t i, const Aabb& box) { refs[k] = SahRef::of(box, i); },
+        [&](std::size_t from, std::size_t n, std::size_t to) { std::copy_n(refs.get() + from, n, refs.get() + to); });
+    count_stored(kept);
+    BuildTree triangle_tree = kept ? build_sah(std::move(refs), kept, config.sah) : BuildTree{};
+    return join(std::move(triangle_tree), build_kind(sphere_boxes, sphere_ids, config));
+  }
+  // The stored primitives (stored_primitives' ids, triangles first) and
+  // their boxes.
+  std::vector<std::uint32_t> ids(triangles);
+  std::vector<Aabb> bounds(triangles);
+  const std::size_t kept = for_each_kept_triangle(
+      geometry, bvh_thread_count(config),
+      [&](std::size_t k, std::uint32_t i, const Aabb& box) {
+        ids[k] = i;
+        bounds[k] = box;
+      },
+      [&](std::size_t from, std::size_t n, std::size_t to) {
+        std::copy_n(ids.begin() + static_cast<std::ptrdiff_t>(from), n, ids.begin() + static_cast<std::ptrdiff_t>(to));
+        std::copy_n(bounds.begin() + static_cast<std::ptrdiff_t>(from), n,
+                    bounds.begin() + static_cast<std::ptrdiff_t>(to));
+      });
+  count_stored(kept);
+  ids.resize(kept);
+  bounds.resize(kept);
+  ids.insert(ids.end(), sphere_ids.begin(), sphere_ids.end());
+  bounds.insert(bounds.end(), sphere_boxes.begin(), sphere_boxes.end());
+  const std::size_t first_sphere = presplit_triangles(geometry, ids, bounds, kept, config.presplit);
   std::span<const Aabb> all_bounds(bounds);
   std::span<const std::uint32_t> all_ids(ids);
   return join(build_kind(all_bounds.first(first_sphere), all_ids.first(first_sphere), config),

@@ -8,6 +8,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include "rtcl/error.hpp"
@@ -58,21 +59,20 @@ struct Box {
   Aabb aabb() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
 };
 
-// A primitive during the build: its box (lane 3 of hi holds the id's bits),
-// 32 bytes, partitioned in place so that every subtree's primitives stay
-// contiguous.
-struct PrimRef {
-  Box box;
-  std::uint32_t id() const { return std::bit_cast<std::uint32_t>(box.hi[3]); }
-  // Box centre, halves first (no overflow near the float range's ends).
-  // Lane 3 is zero: the id's bits read as a float are denormal, and a
-  // multiply by a denormal takes a microcode assist (~100 cycles), which
-  // made the centre alone most of the build's time.
-  Float4 centre() const {
-    Float4 hi = std::bit_cast<Float4>(std::bit_cast<Int4>(box.hi) & Int4{-1, -1, -1, 0});
-    return 0.5f * box.lo + 0.5f * hi;
-  }
-};
+// A primitive during the build (SahRef, bvh_sah.hpp), partitioned in place
+// so that every subtree's primitives stay contiguous; read as a Box (lane 3
+// of hi holds the id's bits).
+inline Box box_of(const SahRef& r) { return std::bit_cast<Box>(r); }
+inline std::uint32_t id_of(const SahRef& r) { return std::bit_cast<std::uint32_t>(r.upper[3]); }
+// Box centre, halves first (no overflow near the float range's ends). Lane
+// 3 is zero: the id's bits read as a float are denormal, and a multiply by
+// a denormal takes a microcode assist (~100 cycles), which made the centre
+// alone most of the build's time.
+inline Float4 centre_of(const SahRef& r) {
+  const Box b = box_of(r);
+  const Float4 hi = std::bit_cast<Float4>(std::bit_cast<Int4>(b.hi) & Int4{-1, -1, -1, 0});
+  return 0.5f * b.lo + 0.5f * hi;
+}
 
 inline float blocks(std::uint32_t n) { return static_cast<float>((n + RTCL_BLOCK_WIDTH - 1) / RTCL_BLOCK_WIDTH); }
 
@@ -137,37 +137,15 @@ struct Range {
 
 class SahBuilder {
  public:
-  // Throws check_builder_input's error for the first invalid box (the
-  // boxes are tested in the constructor's parallel pass over them).
+  // Over boxes and ids (each stored as a SahRef). Throws check_builder_input's
+  // error for the first invalid box (the boxes are tested in the
+  // constructor's parallel pass over them).
   SahBuilder(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config)
-      : config_(config),
-        refs_(std::make_unique_for_overwrite<PrimRef[]>(bounds.size())),
-        ref_count_(bounds.size()) {
-    thread_count_ = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
-    if (ref_count_ < 2 * config.parallel_min_primitives) thread_count_ = 1;
-    const unsigned parts = part_count(ref_count_, thread_count_, config.parallel_min_primitives);
-    std::vector<Range> part_ranges(parts);
-    for_each_part(ref_count_, parts, [&](unsigned part, std::size_t begin, std::size_t end) {
-      Box box = Box::empty(), centres = Box::empty();
-      for (std::size_t i = begin; i < end; ++i) {
-        const Aabb& b = bounds[i];
-        const Float4 lo = {b.lower.x, b.lower.y, b.lower.z, 0.0f}, hi = {b.upper.x, b.upper.y, b.upper.z, 0.0f};
-        // finite with lo <= hi (false for NaN) on every axis
-        const Int4 ok = (lo > -kInf) & (hi < kInf) & (lo <= hi);
-        if (!(ok[0] & ok[1] & ok[2])) throw builder_box_error(ids[i], "SAH builder");
-        refs_[i].box = {lo, hi};
-        refs_[i].box.hi[3] = std::bit_cast<float>(ids[i]);
-        box.grow(refs_[i].box);
-        centres.grow_point(refs_[i].centre());
-      }
-      part_ranges[part] = {0, 0, box, centres};
-    });
-    root_ = {0, static_cast<std::uint32_t>(ref_count_), Box::empty(), Box::empty()};
-    for (const Range& r : part_ranges) {
-      root_.bounds.grow(r.bounds);
-      root_.centres.grow(r.centres);
-    }
-  }
+      : SahBuilder(std::make_unique_for_overwrite<SahRef[]>(bounds.size()), bounds.size(), config,
+                   [&](std::size_t i) { return SahRef::of(bounds[i], ids[i]); }) {}
+  // Over refs the caller filled; tested as above.
+  SahBuilder(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahConfig& config)
+      : SahBuilder(std::move(refs), count, config, Filled{}) {}
 
   BuildTree run() {
     BuildTree tree;
@@ -178,12 +156,50 @@ class SahBuilder {
     tree.prims.resize(ref_count_);
     for_each_part(ref_count_, part_count(ref_count_, thread_count_, config_.parallel_min_primitives),
                   [&](unsigned, std::size_t begin, std::size_t end) {
-                    for (std::size_t i = begin; i < end; ++i) tree.prims[i] = refs_[i].id();
+                    for (std::size_t i = begin; i < end; ++i) tree.prims[i] = id_of(refs_[i]);
                   });
     return tree;
   }
 
  private:
+  // refs_[i] = ref_of(i) for every i (Filled: refs_ as it is), each box
+  // tested (finite, lower <= upper), and the root's bounds, on the
+  // builder's threads.
+  struct Filled {};
+  template <class RefOf>
+  SahBuilder(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahConfig& config, RefOf ref_of)
+      : config_(config), refs_(std::move(refs)), ref_count_(count) {
+    thread_count_ = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
+    if (ref_count_ < 2 * config.parallel_min_primitives) thread_count_ = 1;
+    const unsigned parts = part_count(ref_count_, thread_count_, config.parallel_min_primitives);
+    std::vector<Range> part_ranges(parts);
+    for_each_part(ref_count_, parts, [&](unsigned part, std::size_t begin, std::size_t end) {
+      Box box = Box::empty(), centres = Box::empty();
+      for (std::size_t i = begin; i < end; ++i) {
+        SahRef r;
+        if constexpr (std::is_same_v<RefOf, Filled>) {
+          r = refs_[i];
+        } else {
+          r = ref_of(i);
+          refs_[i] = r;
+        }
+        const Box b = box_of(r);
+        // finite with lo <= hi (false for NaN) on every axis (lane 3 of hi
+        // is the id)
+        const Int4 ok = (b.lo > -kInf) & (b.hi < kInf) & (b.lo <= b.hi);
+        if (!(ok[0] & ok[1] & ok[2])) throw builder_box_error(id_of(r), "SAH builder");
+        box.grow(b);
+        centres.grow_point(centre_of(r));
+      }
+      part_ranges[part] = {0, 0, box, centres};
+    });
+    root_ = {0, static_cast<std::uint32_t>(ref_count_), Box::empty(), Box::empty()};
+    for (const Range& r : part_ranges) {
+      root_.bounds.grow(r.bounds);
+      root_.centres.grow(r.centres);
+    }
+  }
+
   // Best SAH plane over bins of the centroids in the range. Nodes use n / 8
   // bins, at least 8 and at most bin_count: a node's cost is O(n + bins),
   // and the bins that matter are those of the large nodes near the root.
@@ -274,7 +290,7 @@ class SahBuilder {
     std::uint32_t top[3] = {range.begin, range.begin, range.begin};
     float top_area[3] = {-1.0f, -1.0f, -1.0f};
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      float a = refs_[i].box.area();
+      float a = box_of(refs_[i]).area();
       std::uint32_t r = i;
       for (int k = 0; k < 3; ++k)
         if (a > top_area[k]) {
@@ -284,12 +300,12 @@ class SahBuilder {
     }
     for (float& a : top_area) a = std::max(a, 0.0f);  // fewer than three references
     auto pair = [&](int x, int y) {
-      Box b = refs_[top[x]].box;
-      b.grow(refs_[top[y]].box);
+      Box b = box_of(refs_[top[x]]);
+      b.grow(box_of(refs_[top[y]]));
       return b;
     };
     Box all = pair(0, 1);
-    all.grow(refs_[top[2]].box);
+    all.grow(box_of(refs_[top[2]]));
     const float lower = std::min({all.area(), pair(0, 1).area() + top_area[2], pair(0, 2).area() + top_area[1],
                                   pair(1, 2).area() + top_area[0]});
     return area * blocks(range.end - range.begin) <= config_.node_cost * area + lower;
@@ -304,12 +320,12 @@ class SahBuilder {
       std::unique_ptr<Bins> odd = std::make_unique<Bins>();
       odd->clear(map.count);
       for (; i + 1 < end; i += 2) {
-        bins.add(bins_of(refs_[i].centre(), map.offset, map.scale, map.last_bin), refs_[i].box);
-        odd->add(bins_of(refs_[i + 1].centre(), map.offset, map.scale, map.last_bin), refs_[i + 1].box);
+        bins.add(bins_of(centre_of(refs_[i]), map.offset, map.scale, map.last_bin), box_of(refs_[i]));
+        odd->add(bins_of(centre_of(refs_[i + 1]), map.offset, map.scale, map.last_bin), box_of(refs_[i + 1]));
       }
       bins.merge(*odd, map.count);
     }
-    for (; i < end; ++i) bins.add(bins_of(refs_[i].centre(), map.offset, map.scale, map.last_bin), refs_[i].box);
+    for (; i < end; ++i) bins.add(bins_of(centre_of(refs_[i]), map.offset, map.scale, map.last_bin), box_of(refs_[i]));
   }
 
   // Partitions the range by the split's plane; fills both sides' centre
@@ -325,8 +341,8 @@ class SahBuilder {
     const Float4 inf = {kInf, kInf, kInf, kInf};
     std::uint32_t store = range.begin;
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      PrimRef r = refs_[i];
-      Float4 c = r.centre();
+      const SahRef r = refs_[i];
+      const Float4 c = centre_of(r);
       // bins_of(c)[a] < bin: the same arithmetic, before the clamps, which
       // cannot move a value across bin >= 1
       const bool goes_left = (c[a] - offset) * scale < bin;
@@ -356,7 +372,7 @@ class SahBuilder {
       for (std::size_t h = begin; h < end; ++h) store[h] = partition(halves[h], split, sides[h][0], sides[h][1]);
     });
     const std::uint32_t first_right = mid - store[0], second_left = store[1] - mid;
-    PrimRef* refs = refs_.get();
+    SahRef* refs = refs_.get();
     if (first_right <= second_left)
       std::swap_ranges(refs + store[0], refs + mid, refs + store[1] - first_right);
     else
@@ -376,7 +392,7 @@ class SahBuilder {
       if (range.centres.hi[a] - range.centres.lo[a] > range.centres.hi[axis] - range.centres.lo[axis]) axis = a;
     std::uint32_t mid = range.begin + (range.end - range.begin) / 2;
     std::nth_element(refs_.get() + range.begin, refs_.get() + mid, refs_.get() + range.end,
-                     [axis](const PrimRef& x, const PrimRef& y) { return x.centre()[axis] < y.centre()[axis]; });
+                     [axis](const SahRef& x, const SahRef& y) { return centre_of(x)[axis] < centre_of(y)[axis]; });
     return mid;
   }
 
@@ -411,12 +427,12 @@ class SahBuilder {
       left.bounds = left.centres = right.bounds = right.centres = Box::empty();
       left.end = right.begin = median_split(range);
       for (std::uint32_t i = left.begin; i < left.end; ++i) {
-        left.bounds.grow(refs_[i].box);
-        left.centres.grow_point(refs_[i].centre());
+        left.bounds.grow(box_of(refs_[i]));
+        left.centres.grow_point(centre_of(refs_[i]));
       }
       for (std::uint32_t i = right.begin; i < right.end; ++i) {
-        right.bounds.grow(refs_[i].box);
-        right.centres.grow_point(refs_[i].centre());
+        right.bounds.grow(box_of(refs_[i]));
+        right.centres.grow_point(centre_of(refs_[i]));
       }
     }
     const bool left_smaller = left.end - left.begin < right.end - right.begin;
@@ -509,7 +525,7 @@ class SahBuilder {
   };
 
   const SahConfig& config_;
-  std::unique_ptr<PrimRef[]> refs_;  // not initialised before the constructor fills it
+  std::unique_ptr<SahRef[]> refs_;
   std::size_t ref_count_;
   Range root_;  // all of refs_
   // Each subtree built as a task has its own nodes (threads never write to
@@ -527,7 +543,9 @@ class SahBuilder {
 
 }  // namespace
 
-BuildTree build_sah(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config) {
+namespace {
+
+void check_config(const SahConfig& config) {
   if (config.bin_count < 2 || config.bin_count > kMaxBins)
     throw Error("SAH builder: bin_count " + std::to_string(config.bin_count) + " is outside 2..256");
   if (config.max_leaf_size < 1 || config.max_leaf_size > RTCL_BLOCK_WIDTH)
@@ -536,8 +554,21 @@ BuildTree build_sah(std::span<const Aabb> bounds, std::span<const std::uint32_t>
     throw Error("SAH builder: node_cost must be finite and >= 0");
   if (config.max_sah_depth > 1024)
     throw Error("SAH builder: max_sah_depth " + std::to_string(config.max_sah_depth) + " is above 1024");
+}
+
+}  // namespace
+
+BuildTree build_sah(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config) {
+  check_config(config);
   check_builder_sizes(bounds, ids, "SAH builder");
   return SahBuilder(bounds, ids, config).run();
+}
+
+BuildTree build_sah(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahConfig& config) {
+  check_config(config);
+  if (count > 0x7fffffffu) throw Error("SAH builder: " + std::to_string(count) + " primitives exceed 2^31 - 1");
+  if (count > 0 && !refs) throw Error("SAH builder: " + std::to_string(count) + " references and no array");
+  return SahBuilder(std::move(refs), count, config).run();
 }
 
 }  // namespace rtcl

@@ -5,8 +5,10 @@
 // kernel tests in float8 lanes.
 #pragma once
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 
 #include "rtcl/accel/build_tree.hpp"
@@ -53,5 +55,22 @@ struct SahConfig {
 // leaves hold those ids. Throws Error for mismatched spans, a box with a NaN
 // or infinite coordinate or lower > upper, or an invalid config.
 BuildTree build_sah(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config = {});
+
+// One primitive as the SAH builder holds it, 32 bytes: its box's lower and
+// upper corners, lower[3] zero and upper[3] the id's bits.
+struct alignas(16) SahRef {
+  float lower[4];
+  float upper[4];
+
+  static SahRef of(const Aabb& box, std::uint32_t id) {
+    return {{box.lower.x, box.lower.y, box.lower.z, 0.0f},
+            {box.upper.x, box.upper.y, box.upper.z, std::bit_cast<float>(id)}};
+  }
+};
+
+// Builds over refs[0, count), which a caller filled in its own pass over
+// the primitives (SahRef::of), without a copy of them into the builder's
+// array; the same tree as from the boxes and ids, the same errors.
+BuildTree build_sah(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahConfig& config = {});
 
 }  // namespace rtcl
