@@ -122,8 +122,8 @@ Bvh8Node empty_node() {
   return node;
 }
 
-// Blocks below which the gather stays on one thread (a thread start costs
-// about as much as gathering a few hundred blocks).
+// Blocks below which the gather stays on one thread (a part's hand-off to
+// another thread costs about as much as gathering a hundred blocks).
 constexpr std::size_t kParallelMinBlocks = 512;
 // How many blocks ahead of the one being filled the gather prefetches the
 // triangles' index records and leaf boxes, and then their vertices: the
