@@ -9,8 +9,8 @@
 
 #include "rtcl/accel/bvh_sah.hpp"
 #include "rtcl/error.hpp"
-#include "rtcl/parallel.hpp"
 #include "rtcl/layouts.hpp"
+#include "rtcl/parallel.hpp"
 
 namespace rtcl {
 
