@@ -3,6 +3,7 @@
 // errors, the program cache, and errors that name what the user passed.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +16,7 @@
 
 #include "rtcl/accel/accel.hpp"
 #include "rtcl/cl/device.hpp"
+#include "rtcl/cl/program.hpp"
 #include "rtcl/error.hpp"
 #include "support/error_of.hpp"
 #include "support/fixtures.hpp"
@@ -238,6 +240,32 @@ TEST(Device, AdoptRejectsNullHandles) {
   std::string message = error_of([&] { Device::adopt(nullptr, raw.device, raw.queue); });
   EXPECT_NE(message.find("Device::adopt"), std::string::npos) << message;
   error_of([&] { Device::adopt(raw.context, raw.device, nullptr); });
+}
+
+// NVIDIA's compiler ignores #line and reports positions in the assembled
+// source ("<kernel>:N:C"); the log then names the original file and line.
+TEST(KernelSource, CompilerPositionsInTheAssembledSourceNameTheOriginalFileAndLine) {
+  std::filesystem::path root =
+      std::filesystem::temp_directory_path() / ("rtcl-lines-" + std::to_string(getpid()));
+  std::filesystem::create_directories(root / "k");
+  std::ofstream(root / "k" / "main.cl") << "// main line 1\n#include \"k/part.h\"\nint main_line_3;\nint main_line_4;\n";
+  std::ofstream(root / "k" / "part.h") << "int part_line_1;\nint part_line_2;\n";
+  std::string source;
+  {
+    ScopedEnv env("RTCL_KERNEL_DIR", root.string());
+    source = kernel_source("k/main.cl");
+  }
+  std::filesystem::remove_all(root);
+  // The assembled line numbers of each original line, counted here.
+  auto assembled_line_of = [&](const std::string& text) {
+    std::size_t at = source.find(text);
+    return std::count(source.begin(), source.begin() + static_cast<long>(at), '\n') + 1;
+  };
+  auto at = [&](const std::string& text) { return "<kernel>:" + std::to_string(assembled_line_of(text)) + ":"; };
+  std::string log = at("part_line_2") + "7: error: a\n" + at("main_line_4") + "1: warning: b\n" +
+                    "k/main.cl:3:1: note: already named\n<kernel>:999: beyond the source\n";
+  EXPECT_EQ(name_source_lines(log, source), "k/part.h:2:7: error: a\nk/main.cl:4:1: warning: b\n"
+                                            "k/main.cl:3:1: note: already named\n<kernel>:999: beyond the source\n");
 }
 
 // A kernel directory holding one broken file (RTCL_KERNEL_DIR development mode).

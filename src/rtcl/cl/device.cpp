@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cctype>
 #include <cstdlib>
 #include <functional>
 #include <map>
 #include <mutex>
+#include <thread>
 #include <tuple>
 
 #include "rtcl/cl/device_limits.hpp"
@@ -174,7 +176,7 @@ cl::Program Device::program(const std::string& kernel_file, const std::vector<st
     } catch (const cl::Error&) {
       std::string log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(state_->device);
       throw Error("building kernel file " + kernel_file + " (options: " + options + ") failed on " +
-                  state_->info.name + ":\n" + log);
+                  state_->info.name + ":\n" + name_source_lines(log, source));
     }
     state_->programs.emplace(key, program);
     return program;
@@ -196,9 +198,20 @@ void CL_CALLBACK released(cl_mem, void* user_data) {
 
 }  // namespace
 
+// A driver may run a released buffer's destructor callback later, on a
+// thread of its own (NVIDIA's does; PoCL's runs inside clReleaseMemObject):
+// before refusing a buffer that would fit but for what rtcl still counts as
+// live, the queue is finished and the pending callbacks get up to a second.
 void Device::check_fits(std::size_t bytes, const std::string& what) const {
-  check_allocation({state_->info.max_alloc_bytes, state_->info.global_mem_bytes}, bytes, *state_->live_bytes, what,
-                   state_->info.name);
+  const std::size_t global = state_->info.global_mem_bytes;
+  auto fits = [&] { return *state_->live_bytes <= global && bytes <= global - *state_->live_bytes; };
+  if (bytes <= global && !fits()) {
+    state_->queue.finish();
+    for (auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+         !fits() && std::chrono::steady_clock::now() < deadline;)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  check_allocation({state_->info.max_alloc_bytes, global}, bytes, *state_->live_bytes, what, state_->info.name);
 }
 
 cl::Buffer Device::allocate(std::size_t bytes, const char* what, cl_mem_flags flags) const {

@@ -7,6 +7,8 @@
 #include <set>
 #include <sstream>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include "rtcl/error.hpp"
 
@@ -57,6 +59,41 @@ std::string kernel_source(const std::string& path) {
   std::set<std::string> seen;
   std::string out;
   inline_includes(path, seen, out);
+  return out;
+}
+
+std::string name_source_lines(const std::string& log, const std::string& source) {
+  // origin[k]: the file and line of the assembled source's line k + 1
+  static const std::regex line_marker(R"re(^#line (\d+) "([^"]+)"$)re");
+  std::vector<std::pair<std::string, long>> origin;
+  std::istringstream lines(source);
+  std::string line, file;
+  long next = 0;
+  while (std::getline(lines, line)) {
+    std::smatch m;
+    if (std::regex_match(line, m, line_marker)) {
+      origin.emplace_back(std::string(), 0);
+      file = m[2].str();
+      next = std::stol(m[1].str());
+    } else {
+      origin.emplace_back(file, next);
+      if (!file.empty()) ++next;
+    }
+  }
+  static const std::regex position(R"(<(kernel|source)>:(\d+):)");
+  std::string out;
+  auto last = log.cbegin();
+  for (std::sregex_iterator it(log.begin(), log.end(), position), end; it != end; ++it) {
+    const std::smatch& m = *it;
+    out.append(last, m[0].first);
+    std::size_t k = std::stoul(m[2].str());
+    if (k >= 1 && k <= origin.size() && !origin[k - 1].first.empty())
+      out += origin[k - 1].first + ":" + std::to_string(origin[k - 1].second) + ":";
+    else
+      out += m[0].str();
+    last = m[0].second;
+  }
+  out.append(last, log.cend());
   return out;
 }
 

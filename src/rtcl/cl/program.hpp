@@ -12,4 +12,11 @@ namespace rtcl {
 // Throws Error naming the file when it does not exist.
 std::string kernel_source(const std::string& path);
 
+// A build log with the compiler's positions in the assembled source
+// ("<kernel>:N:", as NVIDIA's OpenCL compiler writes them: it ignores #line)
+// rewritten as "file:line:" of the original kernel file, read from the #line
+// markers of `source` (what kernel_source returned). Positions already named
+// by file, and lines without a marker before them, are left as they are.
+std::string name_source_lines(const std::string& log, const std::string& source);
+
 }  // namespace rtcl
