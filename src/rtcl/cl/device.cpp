@@ -198,8 +198,8 @@ void CL_CALLBACK released(cl_mem, void* user_data) {
 
 }  // namespace
 
-// A driver may run a released buffer's destructor callback later, on a
-// thread of its own (NVIDIA's does; PoCL's runs inside clReleaseMemObject):
+// A driver may run a released buffer's destructor callback after
+// clReleaseMemObject has returned (NVIDIA's does; PoCL's runs it inside):
 // before refusing a buffer that would fit but for what rtcl still counts as
 // live, the queue is finished and the pending callbacks get up to a second.
 void Device::check_fits(std::size_t bytes, const std::string& what) const {
