@@ -705,6 +705,16 @@ TEST(Bvh, OccluderRunFollowsTheDevice) {
   EXPECT_EQ(occluder_run_for(5, gpu), 5u);
 }
 
+TEST(Bvh, PacketsServeCoherentCallsOnCpuDevicesOnly) {
+  DeviceInfo cpu, gpu, accelerator;
+  cpu.type = "cpu";
+  gpu.type = "gpu";
+  accelerator.type = "accelerator";
+  EXPECT_TRUE(packets_for_coherent_calls(cpu));
+  EXPECT_FALSE(packets_for_coherent_calls(gpu));
+  EXPECT_FALSE(packets_for_coherent_calls(accelerator));
+}
+
 TEST(Bvh, ReportsStats) {
   Geometry g = random_soup(1000, 61);
   auto accel = make_accel(test_device(), "bvh", g);

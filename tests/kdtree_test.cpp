@@ -342,7 +342,7 @@ TEST(KdPacket, IsRegisteredAndTracesEveryCallInPackets) {
   EXPECT_EQ(packets->rays_per_work_item(Coherence::incoherent), 8u);
   auto kd = make_accel(test_device(), "kdtree:ct=10,depth=20", g);
   EXPECT_EQ(kd->rays_per_work_item(Coherence::incoherent), 1u);
-  EXPECT_EQ(kd->rays_per_work_item(Coherence::coherent), 8u);
+  EXPECT_EQ(kd->rays_per_work_item(Coherence::coherent), packets_for_coherent_calls(test_device().info()) ? 8u : 1u);
   EXPECT_EQ(make_accel(test_device(), "bsp", g)->rays_per_work_item(Coherence::coherent), 1u);
   EXPECT_EQ(packets->stats().node_count, kd->stats().node_count);  // the same tree
 }

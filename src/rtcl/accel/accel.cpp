@@ -103,6 +103,8 @@ std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device) 
   return device.type == "cpu" ? kCpuOccluderRun : 1;
 }
 
+bool packets_for_coherent_calls(const DeviceInfo& device) { return device.type == "cpu"; }
+
 OptionSpec occluder_run_option() {
   return {"occluder_run", OptionType::integer, std::int64_t{0}, 0, 1024, false,
           "occlusion queries: rays (packets of 8 in a packet kernel) per work-item, each tested first against the "

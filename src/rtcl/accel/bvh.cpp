@@ -66,8 +66,9 @@ class BvhAccel final : public Accel {
       : Accel(device, std::move(name),
               bvh_config.traversal == BvhTraversal::packet ? packet_kernels(bvh_config, device)
                                                            : single_ray_kernels(bvh_config, device),
-              bvh_config.traversal == BvhTraversal::packet ? std::nullopt
-                                                           : std::optional(packet_kernels(bvh_config, device)),
+              bvh_config.traversal == BvhTraversal::packet || !packets_for_coherent_calls(device.info())
+                  ? std::nullopt
+                  : std::optional(packet_kernels(bvh_config, device)),
               std::move(defines), stats, config),
         nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
         primitives_(upload(device, bvh.blocks)) {}

@@ -254,7 +254,10 @@ class KdAccel final : public Accel {
               traversal == KdTraversal::packet
                   ? kPacket
                   : TraceKernels{"accel/kdtree.cl", 1, occluder_run_for(occluder_run, device.info())},
-              traversal == KdTraversal::by_coherence ? std::optional(kPacket) : std::nullopt, defines(geometry),
+              traversal == KdTraversal::by_coherence && packets_for_coherent_calls(device.info())
+                  ? std::optional(kPacket)
+                  : std::nullopt,
+              defines(geometry),
               stats, config),
         header_(device.upload(&tree.header, sizeof tree.header, (name + " header").c_str())),
         nodes_(device.upload(tree.nodes.data(), tree.nodes.size() * sizeof(KdNode), (name + " nodes").c_str())),
