@@ -1,11 +1,13 @@
 #include "rtcl/thread_pool.hpp"
 
-#include <unistd.h>
+#include <pthread.h>
+
 
 #include <condition_variable>
 #include <deque>
 #include <exception>
 #include <mutex>
+#include <new>
 #include <thread>
 #include <vector>
 
@@ -25,8 +27,25 @@ struct Batch {
   std::condition_variable finished;
 };
 
+class ThreadPool;
+ThreadPool* the_pool = nullptr;  // for the fork handlers
+
 class ThreadPool {
  public:
+  // A fork while a pool thread holds the mutex, or waits on work_, would
+  // leave the child a locked mutex or a condition variable with waiters
+  // that do not exist there (the child has only the forking thread): the
+  // mutex is held across the fork, and the child starts with a fresh
+  // condition variable and no threads.
+  ThreadPool() {
+    the_pool = this;
+    pthread_atfork([] { the_pool->mutex_.lock(); }, [] { the_pool->mutex_.unlock(); },
+                   [] {
+                     new (&the_pool->work_) std::condition_variable;
+                     the_pool->forget_threads();
+                     the_pool->mutex_.unlock();
+                   });
+  }
   ~ThreadPool() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
@@ -40,7 +59,6 @@ class ThreadPool {
     Batch batch{&job, jobs, 1, jobs, std::vector<std::exception_ptr>(jobs), {}};
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      if (owner_ != getpid()) forget_threads();
       queue_.push_back(&batch);
       unclaimed_ += jobs - 1;
       // every waiting job has an idle thread to take it at once
@@ -91,17 +109,15 @@ class ThreadPool {
     }
   }
 
-  // In a child forked after threads were started (their handles copied, the
-  // threads themselves not): the pool starts anew, the handles let go.
+  // In a forked child (the threads' handles copied, the threads themselves
+  // not): the pool starts anew, the handles let go.
   void forget_threads() {
     for (std::thread& t : threads_) t.detach();
     threads_.clear();
     queue_.clear();
     unclaimed_ = idle_ = 0;
-    owner_ = getpid();
   }
 
-  pid_t owner_ = getpid();  // the process whose threads threads_ holds
   std::mutex mutex_;
   std::condition_variable work_;  // a job is waiting, or the pool stops
   std::deque<Batch*> queue_;      // batches with unclaimed jobs, oldest first

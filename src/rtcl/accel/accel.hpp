@@ -166,6 +166,8 @@ std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, c
 // packet as a work-item of its own to fill its lanes).
 inline constexpr std::uint32_t kCpuOccluderRun = 16;
 std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device);
+// That option, as such structures declare it.
+OptionSpec occluder_run_option();
 
 // Whether a structure's packet kernel serves its Coherence::coherent calls
 // (`bvh`, `bvh-ploc` and `kdtree`; `bvh-packet` and `kdtree-packet` take it
@@ -175,8 +177,6 @@ std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device);
 // rays at 0.35-0.49x and shadow and diffuse rays at 0.04-0.13x the rate of
 // `bvh`).
 bool packets_for_coherent_calls(const DeviceInfo& device);
-// That option, as such structures declare it.
-OptionSpec occluder_run_option();
 
 // The -D options every trace program needs for this geometry.
 std::vector<std::string> primitive_defines(const Geometry& geometry);
