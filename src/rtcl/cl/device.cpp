@@ -203,15 +203,15 @@ void CL_CALLBACK released(cl_mem, void* user_data) {
 // before refusing a buffer that would fit but for what rtcl still counts as
 // live, the queue is finished and the pending callbacks get up to a second.
 void Device::check_fits(std::size_t bytes, const std::string& what) const {
-  const std::size_t global = state_->info.global_mem_bytes;
-  auto fits = [&] { return *state_->live_bytes <= global && bytes <= global - *state_->live_bytes; };
-  if (bytes <= global && !fits()) {
+  const DeviceLimits limits{state_->info.max_alloc_bytes, state_->info.global_mem_bytes};
+  auto fits = [&] { return fits_global_memory(limits, bytes, *state_->live_bytes); };
+  if (bytes <= limits.global_mem_bytes && !fits()) {
     state_->queue.finish();
     for (auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(1);
          !fits() && std::chrono::steady_clock::now() < deadline;)
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  check_allocation({state_->info.max_alloc_bytes, global}, bytes, *state_->live_bytes, what, state_->info.name);
+  check_allocation(limits, bytes, *state_->live_bytes, what, state_->info.name);
 }
 
 cl::Buffer Device::allocate(std::size_t bytes, const char* what, cl_mem_flags flags) const {

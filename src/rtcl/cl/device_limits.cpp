@@ -31,12 +31,16 @@ DeviceLimits limits_with_overrides(DeviceLimits device) {
   return device;
 }
 
+bool fits_global_memory(const DeviceLimits& limits, std::size_t bytes, std::size_t live_bytes) {
+  return bytes <= limits.global_mem_bytes && live_bytes <= limits.global_mem_bytes - bytes;
+}
+
 void check_allocation(const DeviceLimits& limits, std::size_t bytes, std::size_t live_bytes, const std::string& what,
                       const std::string& device_name) {
   if (bytes > limits.max_alloc_bytes)
     throw Error(what + ": " + std::to_string(bytes) + " bytes exceed the largest buffer " + device_name +
                 " allows (" + std::to_string(limits.max_alloc_bytes) + " bytes)");
-  if (bytes > limits.global_mem_bytes || live_bytes > limits.global_mem_bytes - bytes)
+  if (!fits_global_memory(limits, bytes, live_bytes))
     throw Error(what + ": " + std::to_string(bytes) + " bytes, with the " + std::to_string(live_bytes) +
                 " bytes rtcl already holds there, exceed the global memory of " + device_name + " (" +
                 std::to_string(limits.global_mem_bytes) + " bytes)");

@@ -21,6 +21,10 @@ struct DeviceLimits {
 // lowered by RTCL_MAX_ALLOC_BYTES and RTCL_MAX_GLOBAL_BYTES when set.
 DeviceLimits limits_with_overrides(DeviceLimits device);
 
+// Whether `live_bytes` (what rtcl already holds on the device) plus `bytes`
+// stay within limits.global_mem_bytes (without overflow).
+bool fits_global_memory(const DeviceLimits& limits, std::size_t bytes, std::size_t live_bytes);
+
 // Throws Error, naming `what`, the device and both numbers, when a buffer of
 // `bytes` is larger than limits.max_alloc_bytes or when `live_bytes` (what
 // rtcl already holds there) plus `bytes` exceed limits.global_mem_bytes.
