@@ -35,7 +35,7 @@ enum class BvhBuilder {
 // rays 1.4-2.7x the single-ray kernel's rays/s, shadow rays to one light
 // 0.9-1.5x, diffuse bounces 0.56-0.68x).
 enum class BvhTraversal {
-  by_coherence,  // single ray for Coherence::incoherent calls, packets for coherent ones
+  by_coherence,  // packets for Coherence::coherent calls on CPU devices (packets_for_coherent_calls), else single rays
   packet,        // packets for every call (measuring and testing the packet kernel on any rays)
 };
 

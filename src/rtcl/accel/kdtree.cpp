@@ -690,7 +690,7 @@ const StructureSpec& kdtree_structure() {
   static const StructureSpec spec{
       "kdtree",
       "SAH kd-tree: O(N log N) sorted-event build, perfect splits, [min,max] interval traversal; packets of 8 rays "
-      "for coherent calls",
+      "for coherent calls on CPU devices",
       kdtree_options(true)};
   return spec;
 }

@@ -158,7 +158,7 @@ class KdThreads {
 // accel/kdtree_packet.cl (packets of 8 rays).
 enum class KdTraversal {
   single,        // always one ray per work-item
-  by_coherence,  // packets for Coherence::coherent calls, single rays otherwise
+  by_coherence,  // packets for Coherence::coherent calls on CPU devices (packets_for_coherent_calls), else single rays
   packet,        // always packets (for measuring)
 };
 
