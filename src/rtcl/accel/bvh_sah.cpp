@@ -33,6 +33,7 @@ constexpr std::uint32_t kSubtreeRef = 0x80000000u;
 // and a spare lane. Boxes grow with two 4-wide min/max operations.
 typedef float Float4 __attribute__((vector_size(16)));
 typedef int Int4 __attribute__((vector_size(16)));
+typedef std::uint32_t UInt4 __attribute__((vector_size(16)));
 
 inline Float4 min4(Float4 a, Float4 b) { return b < a ? b : a; }
 inline Float4 max4(Float4 a, Float4 b) { return a < b ? b : a; }
@@ -59,6 +60,15 @@ struct Box {
   Aabb aabb() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
 };
 
+// Box::area of boxes[0..2] in lanes 0..2 (lane 3: 0), the same arithmetic
+// per lane.
+inline Float4 areas3(const Box (&boxes)[3]) {
+  const Float4 e0 = boxes[0].hi - boxes[0].lo, e1 = boxes[1].hi - boxes[1].lo, e2 = boxes[2].hi - boxes[2].lo;
+  const Float4 x = {e0[0], e1[0], e2[0], 0.0f}, y = {e0[1], e1[1], e2[1], 0.0f}, z = {e0[2], e1[2], e2[2], 0.0f};
+  const Float4 area = 2.0f * (x * y + y * z + z * x);
+  return x < Float4{0.0f, 0.0f, 0.0f, 0.0f} ? Float4{0.0f, 0.0f, 0.0f, 0.0f} : area;
+}
+
 // A primitive during the build (SahRef, bvh_sah.hpp), partitioned in place
 // so that every subtree's primitives stay contiguous; read as a Box (lane 3
 // of hi holds the id's bits).
@@ -75,6 +85,10 @@ inline Float4 centre_of(const SahRef& r) {
 }
 
 inline float blocks(std::uint32_t n) { return static_cast<float>((n + RTCL_BLOCK_WIDTH - 1) / RTCL_BLOCK_WIDTH); }
+// blocks() of each lane; the block counts (< 2^29) convert as signed ints.
+inline Float4 blocks4(UInt4 n) {
+  return __builtin_convertvector(std::bit_cast<Int4>((n + (RTCL_BLOCK_WIDTH - 1)) / RTCL_BLOCK_WIDTH), Float4);
+}
 
 // The bins of a centre: bins_of(centre, offset, scale, last_bin), count
 // bins per axis.
@@ -239,34 +253,42 @@ class SahBuilder {
     } else {
       bin_range(range.begin, range.end, map, bins);
     }
+    // The sweep, the three axes at once in the lanes of Float4 / UInt4
+    // (lane 3 unused): per lane the same arithmetic as one axis at a time,
+    // and the same plane (the first of least cost, axes in order x, y, z),
+    // without a branch on each cost (the comparisons are unpredictable).
     const std::uint32_t k_count = map.count;
-    Split best;
-    float right_area[kMaxBins];
-    std::uint32_t right_n[kMaxBins];
-    for (int a = 0; a < 3; ++a) {
-      if (!usable[a]) continue;
-      Box acc = Box::empty();
-      std::uint32_t count = 0;
-      for (std::uint32_t k = k_count - 1; k > 0; --k) {
-        acc.grow(bins.box[a][k]);
-        count += bins.count[a][k];
-        right_area[k] = acc.area();
-        right_n[k] = count;
-      }
-      acc = Box::empty();
-      count = 0;
-      for (std::uint32_t k = 1; k < k_count; ++k) {
-        acc.grow(bins.box[a][k - 1]);
-        count += bins.count[a][k - 1];
-        if (count == 0 || right_n[k] == 0) continue;
-        float cost = acc.area() * blocks(count) + right_area[k] * blocks(right_n[k]);
-        if (cost < best.cost) {
-          best.cost = cost;
-          best.axis = a;
-          best.bin = k;
-        }
-      }
+    Float4 right_area[kMaxBins];
+    UInt4 right_n[kMaxBins];
+    Box acc[3] = {Box::empty(), Box::empty(), Box::empty()};
+    UInt4 count = {0, 0, 0, 0};
+    for (std::uint32_t k = k_count - 1; k > 0; --k) {
+      for (int a = 0; a < 3; ++a) acc[a].grow(bins.box[a][k]);
+      count += UInt4{bins.count[0][k], bins.count[1][k], bins.count[2][k], 0};
+      right_area[k] = areas3(acc);
+      right_n[k] = count;
     }
+    const UInt4 zero = {0, 0, 0, 0};
+    const UInt4 usable4 = {usable[0] ? ~0u : 0u, usable[1] ? ~0u : 0u, usable[2] ? ~0u : 0u, 0u};
+    Float4 best_cost = {kInf, kInf, kInf, kInf};
+    UInt4 best_bin = zero;
+    acc[0] = acc[1] = acc[2] = Box::empty();
+    count = zero;
+    for (std::uint32_t k = 1; k < k_count; ++k) {
+      for (int a = 0; a < 3; ++a) acc[a].grow(bins.box[a][k - 1]);
+      count += UInt4{bins.count[0][k - 1], bins.count[1][k - 1], bins.count[2][k - 1], 0};
+      const Float4 cost = areas3(acc) * blocks4(count) + right_area[k] * blocks4(right_n[k]);
+      const UInt4 better = usable4 & (count != zero) & (right_n[k] != zero) & (cost < best_cost);
+      best_cost = better ? cost : best_cost;
+      best_bin = better ? UInt4{k, k, k, k} : best_bin;
+    }
+    Split best;
+    for (int a = 0; a < 3; ++a)
+      if (best_cost[a] < best.cost) {
+        best.cost = best_cost[a];
+        best.axis = a;
+        best.bin = best_bin[a];
+      }
     if (best.axis >= 0) {
       int a = best.axis;
       best.map = map;
@@ -339,22 +361,30 @@ class SahBuilder {
     const float offset = split.map.offset[a], scale = split.map.scale[a];
     const auto bin = static_cast<float>(split.bin);
     const Float4 inf = {kInf, kInf, kInf, kInf};
+    // The centre bounds in locals, in registers for the loop (refs_' stores
+    // could alias the callers' ranges).
+    Box left_centres = left.centres, right_centres = right.centres;
+    SahRef* refs = refs_.get();
     std::uint32_t store = range.begin;
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      const SahRef r = refs_[i];
+      const SahRef r = refs[i];
       const Float4 c = centre_of(r);
       // bins_of(c)[a] < bin: the same arithmetic, before the clamps, which
-      // cannot move a value across bin >= 1
-      const bool goes_left = (c[a] - offset) * scale < bin;
-      refs_[i] = refs_[store];
-      refs_[store] = r;
+      // cannot move a value across bin >= 1; c[a] from the record's own
+      // floats, as centre_of computes it (a is not the id's lane)
+      const float centre_a = 0.5f * r.lower[a] + 0.5f * r.upper[a];
+      const bool goes_left = (centre_a - offset) * scale < bin;
+      refs[i] = refs[store];
+      refs[store] = r;
       store += goes_left;
       const Int4 mask = Int4{0, 0, 0, 0} - static_cast<int>(goes_left);
-      left.centres.lo = min4(left.centres.lo, mask ? c : inf);
-      left.centres.hi = max4(left.centres.hi, mask ? c : -inf);
-      right.centres.lo = min4(right.centres.lo, mask ? inf : c);
-      right.centres.hi = max4(right.centres.hi, mask ? -inf : c);
+      left_centres.lo = min4(left_centres.lo, mask ? c : inf);
+      left_centres.hi = max4(left_centres.hi, mask ? c : -inf);
+      right_centres.lo = min4(right_centres.lo, mask ? inf : c);
+      right_centres.hi = max4(right_centres.hi, mask ? -inf : c);
     }
+    left.centres = left_centres;
+    right.centres = right_centres;
     return store;
   }
 
