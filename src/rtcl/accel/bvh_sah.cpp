@@ -367,12 +367,13 @@ class SahBuilder {
     SahRef* refs = refs_.get();
     std::uint32_t store = range.begin;
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
-      const SahRef r = refs[i];
-      const Float4 c = centre_of(r);
       // bins_of(c)[a] < bin: the same arithmetic, before the clamps, which
       // cannot move a value across bin >= 1; c[a] from the record's own
-      // floats, as centre_of computes it (a is not the id's lane)
-      const float centre_a = 0.5f * r.lower[a] + 0.5f * r.upper[a];
+      // floats in the array, as centre_of computes it (a is not the id's
+      // lane)
+      const float centre_a = 0.5f * refs[i].lower[a] + 0.5f * refs[i].upper[a];
+      const SahRef r = refs[i];
+      const Float4 c = centre_of(r);
       const bool goes_left = (centre_a - offset) * scale < bin;
       refs[i] = refs[store];
       refs[store] = r;
