@@ -254,8 +254,8 @@ BvhConfig resolve_bvh_config(const StructureSpec& structure, const AccelConfig& 
 }
 
 const StructureSpec& bvh_structure() {
-  static const StructureSpec spec{"bvh", "8-wide BVH, top-down binned SAH; packets of 8 rays for coherent calls on CPU devices",
-                                  sah_options()};
+  static const StructureSpec spec{
+      "bvh", "8-wide BVH, top-down binned SAH; packets of 8 rays for coherent calls on CPU devices", sah_options()};
   return spec;
 }
 

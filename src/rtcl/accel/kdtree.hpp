@@ -70,8 +70,8 @@ KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config = {});
 // Its registry entries: depth, ct (traversal_cost), ci (intersection_cost),
 // empty (empty_bonus), batch. "kdtree" traces Coherence::coherent calls on
 // CPU devices in packets of 8 rays (accel/kdtree_packet.cl) and the others
-// one ray per work-item (accel/kdtree.cl; packets_for_coherent_calls); "kdtree-packet", the same tree, always in
-// packets (for measuring).
+// one ray per work-item (accel/kdtree.cl; packets_for_coherent_calls);
+// "kdtree-packet", the same tree, always in packets (for measuring).
 const StructureSpec& kdtree_structure();
 const StructureSpec& kdtree_packet_structure();
 
