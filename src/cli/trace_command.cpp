@@ -175,9 +175,10 @@ void add_trace_command(CLI::App& app) {
   cmd->add_flag("--coherent", options->coherent,
                 "the rays come in coherent packets: each consecutive group of 8 (rays 0-7, 8-15, ...) has nearby "
                 "origins and similar directions, e.g. camera rays in 8x8 screen-tile order or shadow rays towards "
-                "one light in pixel order. Structures with a packet kernel (bvh, bvh-ploc) then trace 8 rays per "
-                "work-item: faster for such rays, slower for scattered ones; the closest t is the same (on an exact "
-                "tie another primitive may be reported)");
+                "one light in pixel order. On a CPU device, structures with a packet kernel (bvh, bvh-ploc, kdtree) "
+                "then trace 8 rays per work-item: faster for such rays, slower for scattered ones; the closest t is "
+                "the same (on an exact tie another primitive may be reported). Other devices trace one ray per "
+                "work-item either way (faster there)");
   cmd->callback([options] { run_trace(*options); });
 }
 
