@@ -5,8 +5,9 @@
  * primitives, also tested in float8 lanes.
  *
  * Closest hit: the children a ray enters are pushed sorted by entry
- * distance, nearest on top, and the top is taken next; an entry popped with
- * an entry distance beyond the current hit is skipped. Any hit: pushed in
+ * distance, nearest on top, and the top is taken next (kept in registers,
+ * never stored: shared/bvh8_stack.h); an entry popped with an entry
+ * distance beyond the current hit is skipped. Any hit: pushed in
  * lane order, and the first hit ends the traversal.
  *
  * Stack: a node with k children pushes at most k entries and pops one, so
@@ -137,7 +138,9 @@ __attribute__((noinline)) int bvh_traverse(const TraceRay* s, HitState* h, globa
       int8 hit = intersect_boxes8(node, s, h->t_best, &t_entry);
 #endif
       if (rtcl_any8(hit)) {
-        RTCL_BVH8_PUSH_CHILDREN
+        RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST
+        ref = near_entry;
+        continue;
       }
     } else {
       int leaf = ~ref;

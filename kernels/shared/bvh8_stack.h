@@ -1,12 +1,13 @@
 /* The ordered push of a BVH8 node's children (kernels/accel/bvh.cl,
- * bvh_motion.cl): the children whose lanes `hit` holds go onto the stack
- * (stack_t, stack_ref, top sp), kept sorted by decreasing entry distance
- * t_entry within [sp at the node, sp), so the nearest child pops first; an
- * any-hit query skips the sorting and leaves stack_t unwritten: its first
- * hit ends the traversal, so its pops test no entry distance (measured:
- * 0.92-1.13x the shadow rays' kernel time, medians of two runs, above
- * 1.03x in 6 of 8, README "Kernel levers on the single-ray BVH"). `node`
- * is the Bvh8Node whose child[k] is pushed for lane k. OpenCL C only. */
+ * bvh_motion.cl, bvh_packet.cl, kdtree.cl): the children whose lanes `hit`
+ * holds go onto the stack (stack_t, stack_ref, top sp), kept sorted by
+ * decreasing entry distance t_entry within [sp at the node, sp), so the
+ * nearest child pops first; an any-hit query skips the sorting and leaves
+ * stack_t unwritten: its first hit ends the traversal, so its pops test no
+ * entry distance (measured: 0.92-1.13x the shadow rays' kernel time,
+ * medians of two runs, above 1.03x in 6 of 8, README "Kernel levers on the
+ * single-ray BVH"). `node` is the Bvh8Node whose child[k] is pushed for
+ * lane k. OpenCL C only. */
 #ifndef RTCL_SHARED_BVH8_STACK_H
 #define RTCL_SHARED_BVH8_STACK_H
 
@@ -16,17 +17,23 @@
 #define RTCL_BVH8_ENTRY(k) node->child[k]
 #endif
 
-#define RTCL_BVH8_PUSH_LANE(k)                                \
-  if (hit.s##k) {                                             \
-    float t = t_entry.s##k;                                   \
-    int j = sp++;                                             \
-    while (!RTCL_ANY_HIT && j > base && stack_t[j - 1] < t) { \
-      stack_t[j] = stack_t[j - 1];                            \
-      stack_ref[j] = stack_ref[j - 1];                        \
-      --j;                                                    \
-    }                                                         \
-    if (!RTCL_ANY_HIT) stack_t[j] = t;                        \
-    stack_ref[j] = RTCL_BVH8_ENTRY(k);                        \
+/* Pushes entry E with entry distance T above the entries of distance < T
+ * pushed since `base` (closest hit), or on top (any hit). */
+#define RTCL_BVH8_PUSH_SORTED(T, E)                             \
+  {                                                             \
+    int j = sp++;                                               \
+    while (!RTCL_ANY_HIT && j > base && stack_t[j - 1] < (T)) { \
+      stack_t[j] = stack_t[j - 1];                              \
+      stack_ref[j] = stack_ref[j - 1];                          \
+      --j;                                                      \
+    }                                                           \
+    if (!RTCL_ANY_HIT) stack_t[j] = (T);                        \
+    stack_ref[j] = (E);                                         \
+  }
+
+#define RTCL_BVH8_PUSH_LANE(k)                          \
+  if (hit.s##k) {                                       \
+    RTCL_BVH8_PUSH_SORTED(t_entry.s##k, RTCL_BVH8_ENTRY(k)) \
   }
 
 /* Needs in scope: int8 hit, float8 t_entry, node, stack_t, stack_ref, sp. */
@@ -35,6 +42,44 @@
     int base = sp;                                                                          \
     RTCL_BVH8_PUSH_LANE(0) RTCL_BVH8_PUSH_LANE(1) RTCL_BVH8_PUSH_LANE(2) RTCL_BVH8_PUSH_LANE(3) \
     RTCL_BVH8_PUSH_LANE(4) RTCL_BVH8_PUSH_LANE(5) RTCL_BVH8_PUSH_LANE(6) RTCL_BVH8_PUSH_LANE(7) \
+  }
+
+/* Lane k of RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST: the entry that would be on
+ * top of the stack so far stays in (near_t, near_entry), out of the stack.
+ * A lane not farther than it takes its place (ties: the later lane is on
+ * top, as RTCL_BVH8_PUSH_SORTED leaves it); any hit: the later lane. */
+#define RTCL_BVH8_NEAR_LANE(k)                    \
+  if (hit.s##k) {                                 \
+    float t = t_entry.s##k;                       \
+    int entry = RTCL_BVH8_ENTRY(k);               \
+    if (!have) {                                  \
+      have = 1;                                   \
+      near_t = t;                                 \
+      near_entry = entry;                         \
+    } else if (RTCL_ANY_HIT || t <= near_t) {     \
+      RTCL_BVH8_PUSH_SORTED(near_t, near_entry)   \
+      near_t = t;                                 \
+      near_entry = entry;                         \
+    } else {                                      \
+      RTCL_BVH8_PUSH_SORTED(t, entry)             \
+    }                                             \
+  }
+
+/* RTCL_BVH8_PUSH_CHILDREN followed by the pop of its top, without the
+ * round trip through the stack: declares int near_entry, the entry the pop
+ * would return (its distance is within the ray's interval, so the pop's
+ * test would pass), and pushes the others in the same order. Needs some
+ * lane of `hit` set. The next node's address then comes from the node's
+ * child load in registers, not from a store and a reload (measured: 1.02-
+ * 1.08x the single-ray BVH's kernel time with the one-test edge check,
+ * README "Kernel levers on the single-ray BVH"). */
+#define RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST                                                   \
+  int near_entry = 0;                                                                         \
+  {                                                                                           \
+    int base = sp, have = 0;                                                                  \
+    float near_t = 0.0f;                                                                      \
+    RTCL_BVH8_NEAR_LANE(0) RTCL_BVH8_NEAR_LANE(1) RTCL_BVH8_NEAR_LANE(2) RTCL_BVH8_NEAR_LANE(3) \
+    RTCL_BVH8_NEAR_LANE(4) RTCL_BVH8_NEAR_LANE(5) RTCL_BVH8_NEAR_LANE(6) RTCL_BVH8_NEAR_LANE(7) \
   }
 
 #endif

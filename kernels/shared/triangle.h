@@ -13,23 +13,18 @@
 
 #include "shared/exact.h"
 
-/* Edge function a*d - b*c; where the float result is exactly zero it is
+/* Edge function a*d - b*c in float. */
+inline float8 rtcl_edge8(float8 a, float8 b, float8 c, float8 d) { return a * d - b * c; }
+
+/* The lanes of edge function e = a*d - b*c that are exactly zero in float,
  * recomputed in double (Woop et al. 2013, section 4): a shared edge is then
  * decided identically by both triangles that own it. */
-inline float8 rtcl_edge8(float8 a, float8 b, float8 c, float8 d) {
-  float8 e = a * d - b * c;
-#if defined(RTCL_HAS_FP64) && defined(RTCL_PRECISION_ROBUST)
-  /* rtcl_any8, not any(): PoCL turns any() into a test and branch per
-   * lane (measured: 1.02-1.07x the BVH's rays/s, README "Results") */
-  if (rtcl_any8(e == 0.0f)) {
-    /* two double4 halves: double8 is not a native vector type on AVX2 */
-    double4 lo = convert_double4(a.lo) * convert_double4(d.lo) - convert_double4(b.lo) * convert_double4(c.lo);
-    double4 hi = convert_double4(a.hi) * convert_double4(d.hi) - convert_double4(b.hi) * convert_double4(c.hi);
-    float8 ed = (float8)(convert_float4(lo), convert_float4(hi));
-    e = select(e, ed, e == 0.0f);
-  }
-#endif
-  return e;
+inline float8 rtcl_edge8_exact_zeros(float8 e, float8 a, float8 b, float8 c, float8 d) {
+  /* two double4 halves: double8 is not a native vector type on AVX2 */
+  double4 lo = convert_double4(a.lo) * convert_double4(d.lo) - convert_double4(b.lo) * convert_double4(c.lo);
+  double4 hi = convert_double4(a.hi) * convert_double4(d.hi) - convert_double4(b.hi) * convert_double4(c.hi);
+  float8 ed = (float8)(convert_float4(lo), convert_float4(hi));
+  return select(e, ed, e == 0.0f);
 }
 
 /* Moller-Trumbore, every argument per lane (a single-ray caller broadcasts
@@ -79,6 +74,15 @@ RTCL_LANES_INLINE Watertight8 rtcl_watertight_edges8(float8 ax, float8 ay, float
   w.U = rtcl_edge8(w.Cx, w.Cy, w.Bx, w.By);
   w.V = rtcl_edge8(w.Ax, w.Ay, w.Cx, w.Cy);
   w.W = rtcl_edge8(w.Bx, w.By, w.Ax, w.Ay);
+#if defined(RTCL_HAS_FP64) && defined(RTCL_PRECISION_ROBUST)
+  /* one test for the three edges: rtcl_any8, not any() (PoCL turns any()
+   * into a test and branch per lane) */
+  if (rtcl_any8((w.U == 0.0f) | (w.V == 0.0f) | (w.W == 0.0f))) {
+    w.U = rtcl_edge8_exact_zeros(w.U, w.Cx, w.Cy, w.Bx, w.By);
+    w.V = rtcl_edge8_exact_zeros(w.V, w.Ax, w.Ay, w.Cx, w.Cy);
+    w.W = rtcl_edge8_exact_zeros(w.W, w.Bx, w.By, w.Ax, w.Ay);
+  }
+#endif
   return w;
 }
 
