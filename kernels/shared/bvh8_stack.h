@@ -66,10 +66,12 @@
   }
 
 /* RTCL_BVH8_PUSH_CHILDREN followed by the pop of its top, without the
- * round trip through the stack: declares int near_entry, the entry the pop
- * would return (its distance is within the ray's interval, so the pop's
- * test would pass), and pushes the others in the same order. Needs some
- * lane of `hit` set. The next node's address then comes from the node's
+ * round trip through the stack: declares int near_entry, the entry on top,
+ * and pushes the others in the same order. Needs some lane of `hit` set.
+ * The pop's distance test is not made for near_entry: it fails only where
+ * the widened entry distance lies above the current hit by less than the
+ * slab widening, and the child then visited holds nothing nearer (its
+ * tests use the same hit). The next node's address then comes from the node's
  * child load in registers, not from a store and a reload (measured: 1.02-
  * 1.08x the single-ray BVH's kernel time with the one-test edge check,
  * README "Kernel levers on the single-ray BVH"). */
