@@ -10,8 +10,9 @@
  * distance beyond the current hit is skipped. Any hit: pushed in
  * lane order, and the first hit ends the traversal.
  *
- * Stack: a node with k children pushes at most k entries and pops one, so
- * the stack never holds more than, over all nodes v, the sum of
+ * Stack: a node with k children pushes at most k - 1 entries and takes the
+ * nearest directly (as pushing k and popping one), so the stack never
+ * holds more than, over all nodes v, the sum of
  * (children - 1) over v's ancestors plus v's children. The host computes
  * that bound from the tree (flatten_bvh8) and compiles with
  * -DRTCL_STACK_SIZE >= it.

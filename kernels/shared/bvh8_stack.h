@@ -72,9 +72,10 @@
  * the widened entry distance lies above the current hit by less than the
  * slab widening, and the child then visited holds nothing nearer (its
  * tests use the same hit). The next node's address then comes from the node's
- * child load in registers, not from a store and a reload (measured: 1.02-
- * 1.08x the single-ray BVH's kernel time with the one-test edge check,
- * README "Kernel levers on the single-ray BVH"). */
+ * child load in registers, not from a store and a reload (measured
+ * with the one-test edge check: 0.99-1.09x the single-ray BVH's kernel
+ * time, above 1.02x on eleven of twelve bench/ sets, README "The nearest
+ * child in registers and one zero-edge test"). */
 #define RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST                                                   \
   int near_entry = 0;                                                                         \
   {                                                                                           \
