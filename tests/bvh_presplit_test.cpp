@@ -124,8 +124,8 @@ TEST(Presplit, FlattenAcceptsRepeatedTrianglesOnlyWhenTold) {
   BuildTree tree = build_binary_bvh(g, config, &stored);
   EXPECT_EQ(stored, g.triangles.size());
   ASSERT_GT(tree.prims.size(), stored);
-  EXPECT_NO_THROW(flatten_bvh8(tree, g, true, 0, true));
-  EXPECT_THROW(flatten_bvh8(tree, g, true, 0, false), Error);
+  EXPECT_NO_THROW(flatten_bvh8(tree, g, {.split_references = true}));
+  EXPECT_THROW(flatten_bvh8(tree, g, {.split_references = false}), Error);
 }
 
 TEST(Presplit, AnswersAsBruteForceAlsoAlongSplitPlanes) {

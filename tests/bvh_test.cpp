@@ -545,10 +545,10 @@ TEST(Bvh, FlattenDoesNotDependOnTheThreads) {
   Geometry g = soup_with_spheres(20000, 4000, 52);
   BuildTree tree = build_binary_bvh(g);
   ASSERT_GE(tree.nodes.size(), 4096u);
-  Bvh8 one = flatten_bvh8(tree, g, true, 1);
+  Bvh8 one = flatten_bvh8(tree, g, {.thread_count = 1});
   EXPECT_EQ(check_wide(one, g), "");
   for (unsigned threads : {2u, 3u}) {
-    Bvh8 many = flatten_bvh8(tree, g, true, threads);
+    Bvh8 many = flatten_bvh8(tree, g, {.thread_count = threads});
     EXPECT_TRUE(same_bytes(one.nodes, many.nodes)) << threads << " threads";
     EXPECT_TRUE(same_bytes(one.blocks.triangles, many.blocks.triangles)) << threads << " threads";
     EXPECT_TRUE(same_bytes(one.blocks.spheres, many.blocks.spheres)) << threads << " threads";
@@ -559,7 +559,7 @@ TEST(Bvh, FlattenDoesNotDependOnTheThreads) {
 
 std::string flatten_error(const BuildTree& tree, const Geometry& g, unsigned threads) {
   try {
-    flatten_bvh8(tree, g, true, threads);
+    flatten_bvh8(tree, g, {.thread_count = threads});
   } catch (const Error& e) {
     return e.what();
   }
@@ -576,7 +576,7 @@ TEST(Bvh, FlattenRejectsMismatchesOnEveryThread) {
   // where the tree holds the latter; the walk (hence the blocks) does not
   // depend on which ids the leaves hold.
   auto ends = [&](const BuildTree& t) {
-    Bvh8 bvh = flatten_bvh8(t, g, true, 2);
+    Bvh8 bvh = flatten_bvh8(t, g, {.thread_count = 2});
     auto first = static_cast<std::uint32_t>(bvh.blocks.triangles.front().prim[0]);
     auto last = static_cast<std::uint32_t>(bvh.blocks.triangles.back().prim[0]);
     auto at = static_cast<std::size_t>(std::find(t.prims.begin(), t.prims.end(), last) - t.prims.begin());

@@ -16,9 +16,10 @@
 // means rtcl builds faster), then the medians of rtcl's phases (validate,
 // the binary build, the flatten).
 //
-// Environment: RTCL_SCENES_DIR; AB_PRESPLIT: values of the bvh's presplit
-// option, comma-separated (default 0); with several, each is a version of
-// rtcl's build of its own row, all in every round, the order rotated;
+// Environment: RTCL_SCENES_DIR; AB_BVH: rtcl's builds as `--accel` specs of
+// the bvh, separated by spaces (default "bvh"; e.g. "bvh bvh:presplit=16
+// bvh:greedy_levels=1024"); with several, each is a version of rtcl's build
+// of its own row, all in every round, the order rotated;
 // AB_THREADS: the host threads of both builders (default every hardware
 // thread; rtcl's validate always uses them all), e.g. 1 to compare the
 // builders' serial work.
@@ -26,11 +27,13 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/options.hpp"
 #include "rtcl/bench/embree_baseline.hpp"
 #include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/error.hpp"
@@ -67,7 +70,7 @@ std::vector<double> rtcl_build_ms(const Geometry& geometry, const BvhConfig& con
   const Clock::time_point validated = Clock::now();
   BuildTree tree = build_binary_bvh(geometry, config);
   const Clock::time_point built = Clock::now();
-  Bvh8 bvh = flatten_bvh8(tree, geometry, config);
+  Bvh8 bvh = flatten_bvh8(tree, geometry, flatten_options(config));
   const Clock::time_point flattened = Clock::now();
   if (bvh.nodes.empty()) throw Error("empty BVH");
   return {ms(start, flattened), ms(start, validated), ms(validated, built), ms(built, flattened)};
@@ -100,16 +103,19 @@ int run(int argc, char** argv) {
       throw Error(std::string("AB_THREADS: '") + threads_env + "' is not a count of 1..1024");
     threads = static_cast<unsigned>(value);
   }
-  std::vector<BvhConfig> configs;  // the "bvh" structure's defaults (SAH on `threads`), presplit apart
-  const char* presplit_env = std::getenv("AB_PRESPLIT");
-  for (const std::string& value : split(presplit_env && *presplit_env ? presplit_env : "0")) {
-    BvhConfig config;
+  std::vector<BvhConfig> configs;  // AB_BVH's builds, SAH on `threads`
+  std::vector<std::string> labels;
+  const char* bvh_env = std::getenv("AB_BVH");
+  std::istringstream specs(bvh_env && *bvh_env ? bvh_env : "bvh");
+  for (std::string text; specs >> text;) {
+    const AccelSpec spec = parse_accel_spec(text, "AB_BVH " + text);
+    if (spec.name != "bvh") throw Error("AB_BVH " + text + ": not a spec of the bvh");
+    AccelConfig accel_config;
+    accel_config.options = spec.options;
+    BvhConfig config = resolve_bvh_config(structure_spec(spec.name), accel_config);
     config.sah.thread_count = threads;
-    char* end = nullptr;
-    config.presplit = std::strtof(value.c_str(), &end);
-    if (end == value.c_str() || *end || !(config.presplit >= 0.0f))
-      throw Error("AB_PRESPLIT: '" + value + "' is not a number >= 0");
     configs.push_back(config);
+    labels.push_back(text);
   }
   for (const std::string& name : scenes)
     if (name.rfind("soup:", 0) != 0 && !find_scene_spec(name))
@@ -140,11 +146,7 @@ int run(int argc, char** argv) {
     for (std::size_t v = 0; v < configs.size(); ++v) {
       const std::vector<double>& ours = phases[v][0];
       std::string label = name;
-      if (configs.size() > 1 || configs[v].presplit > 0.0f) {
-        char option[32];
-        std::snprintf(option, sizeof option, " presplit=%g", configs[v].presplit);
-        label += option;
-      }
+      if (configs.size() > 1 || labels[v] != "bvh") label += " " + labels[v];
       std::printf("| %s | %zu | %.1f / %.1f | %.1f / %.1f | %.2f / %.2f |\n", label.c_str(),
                   geometry.triangles.size(), fastest(ours), median(ours), fastest(theirs), median(theirs),
                   fastest(ours) / fastest(theirs), median(ours) / median(theirs));

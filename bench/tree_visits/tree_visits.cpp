@@ -152,7 +152,7 @@ int run(int argc, char** argv) {
       AccelConfig config;
       config.options = accel_spec.options;
       const BvhConfig bvh_config = resolve_bvh_config(structure_spec(accel_spec.name), config);
-      const Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, bvh_config), geometry, bvh_config);
+      const Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, bvh_config), geometry, flatten_options(bvh_config));
       double cost = 0, lanes = 0;
       tree_cost(bvh, &cost, &lanes);
       std::printf("  %-22s %6zu nodes %6zu blocks %.2f lanes/block  SAH cost %6.2f", argv[s], bvh.nodes.size(),

@@ -50,6 +50,15 @@ struct BvhConfig {
   // bytes. Rarely applies to SAH trees, whose leaves are already full (bunny:
   // 2 blocks of 9,465 saved); off changes nothing else.
   bool merge_leaves = true;
+  // Collapse: the wide nodes of the top greedy_levels levels (the root's
+  // is level 1) keep opening their child of largest area until they have
+  // eight children; below them each wide node takes the SAH-optimal layout
+  // of its subtree (bvh_collapse.hpp). 0: optimal throughout; a level
+  // beyond the tree's depth: greedy throughout. Measured (README "The
+  // collapse into wide nodes"): 2 traced the twelve bench/ sets 1-9% faster
+  // than greedy throughout (medians of two runs); optimal throughout lost
+  // 4-12% on sponza's primary rays.
+  std::uint32_t greedy_levels = 2;
   // Early split clipping (bvh_presplit.hpp): triangles whose box's surface
   // area exceeds presplit times the mean enter the builder as several
   // references; 0 = off (the default). Measured (README "Build options
@@ -95,10 +104,13 @@ struct Bvh8 {
 // stored primitives.
 BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config = {}, std::size_t* stored = nullptr);
 
-// Collapses the binary tree into 8-wide nodes: each wide node takes the two
-// children of a binary node and keeps opening the child with the largest
-// surface area until it has eight children or only leaves (then merges small
-// sibling leaves when `merge_leaves`). Checked: throws Error when the tree
+// Collapses the binary tree into 8-wide nodes: a wide node of the top
+// `greedy_levels` levels takes the two children of a binary node and keeps
+// opening the child with the largest surface area until it has eight
+// children or only leaves; one below takes the SAH-optimal layout of its
+// subtree, whole subtrees of up to eight primitives as one block
+// (bvh_collapse.hpp); either then merges small sibling leaves when
+// `merge_leaves`. Checked: throws Error when the tree
 // does not hold every stored primitive of `geometry` exactly once in leaves
 // of 1..8 primitives of one kind whose boxes contain them, or its stack need
 // exceeds kBvhMaxStackSize. With `split_references` (a presplit build) a
@@ -106,12 +118,18 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config = {
 // box, once per block. The blocks are filled on up to `thread_count`
 // threads (0 = all hardware threads); the result does not depend on the
 // threads.
-Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves = true,
-                  unsigned thread_count = 0, bool split_references = false);
+struct FlattenOptions {
+  bool merge_leaves = true;
+  unsigned thread_count = 0;
+  bool split_references = false;
+  std::uint32_t greedy_levels = BvhConfig{}.greedy_levels;
+};
+Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, const FlattenOptions& options = {});
 
-// The flatten of a tree built by build_binary_bvh(geometry, config): the
-// config's merge_leaves and threads, split references where it presplits.
-Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, const BvhConfig& config);
+// The flatten options of a tree built by build_binary_bvh(geometry, config):
+// the config's merge_leaves, threads and greedy_levels, split references
+// where it presplits.
+FlattenOptions flatten_options(const BvhConfig& config);
 
 // The threads the config's builder may use (its thread_count).
 unsigned bvh_thread_count(const BvhConfig& config);

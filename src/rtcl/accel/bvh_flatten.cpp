@@ -1,7 +1,10 @@
 // flatten_bvh8 (bvh.hpp): the binary build tree collapsed into 8-wide nodes
 // and primitive blocks, in three passes.
 //
-// 1. Walk: wide nodes are formed depth first. A wide node's inner children
+// 1. Walk: wide nodes are formed depth first: those of the top
+//    greedy_levels wide levels by opening the child of largest area until
+//    eight, those below by the SAH-optimal plan (bvh_collapse.hpp). A wide
+//    node's inner children
 //    get consecutive indices when it is formed, and the first child's
 //    subtree is formed before the second's; blocks are numbered in the order
 //    their wide nodes are formed. A block is recorded as its lanes'
@@ -27,6 +30,7 @@
 #include <vector>
 
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/bvh_collapse.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/parallel.hpp"
 
@@ -144,18 +148,19 @@ inline void prefetch(const void* p) {
 
 class Flattener {
  public:
-  Flattener(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count,
-            bool split_references)
+  Flattener(const BuildTree& tree, const Geometry& geometry, const FlattenOptions& options)
       : tree_(tree),
         geometry_(geometry),
-        merge_leaves_(merge_leaves),
-        split_references_(split_references),
+        merge_leaves_(options.merge_leaves),
+        split_references_(options.split_references),
+        greedy_levels_(options.greedy_levels),
         node_seen_(tree.nodes.size()) {
-    threads_ = thread_count ? thread_count : std::max(1u, std::thread::hardware_concurrency());
+    threads_ = options.thread_count ? options.thread_count : std::max(1u, std::thread::hardware_concurrency());
   }
 
   Bvh8 run() {
     if (tree_.empty()) fail("the build tree is empty");
+    plan_ = plan_collapse(tree_, geometry_);
     walk();
     gather();
     check_every_primitive_once();
@@ -192,7 +197,7 @@ class Flattener {
     while (!todo.empty()) {
       Todo t = todo.back();
       todo.pop_back();
-      SlotList slots = form_slots(t.binary);
+      SlotList slots = form_slots(t.binary, t.depth);
       // The kernel pushes the children it enters and pops the one it visits
       // next (kernels/accel/bvh.cl): entries peak at t.stack + children.
       auto children = static_cast<std::uint32_t>(slots.size());
@@ -308,11 +313,22 @@ class Flattener {
     return s;
   }
 
-  // The children of the wide node made from binary node n.
-  SlotList form_slots(std::uint32_t n) {
+  // The children of the wide node made from binary node n at wide depth
+  // `depth` (the root's 1): greedy in the top greedy_levels_, else planned.
+  SlotList form_slots(std::uint32_t n, std::uint32_t depth) {
     SlotList slots;
-    if (tree_.nodes[n].is_leaf()) {
+    const BuildNode& b = tree_.nodes[n];
+    if (b.is_leaf()) {
       slots.push_back(slot_of(n));
+      return slots;
+    }
+    if (depth > greedy_levels_) {
+      check_children(n);
+      const auto [left, right] = plan_.wide_split(n);
+      distribute(b.child[0], left, slots);
+      distribute(b.child[1], right, slots);
+      while (merge_leaves_ && merge_one_pair(slots)) {
+      }
       return slots;
     }
     open(n, slots);
@@ -338,16 +354,58 @@ class Flattener {
     return slots;
   }
 
-  // Appends the two children of inner binary node n, checked: each exists,
-  // is reached once and lies inside n's box.
-  void open(std::uint32_t n, SlotList& slots) {
+  // Checks the two children of inner binary node n: each exists, is
+  // reached once and lies inside n's box.
+  void check_children(std::uint32_t n) {
     const BuildNode& b = tree_.nodes[n];
     for (std::uint32_t c : b.child) {
       visit(c);
       if (!b.bounds.contains(tree_.nodes[c].bounds))
         fail("node " + std::to_string(n) + " does not contain its child " + std::to_string(c));
-      slots.push_back(slot_of(c));
     }
+  }
+
+  // Appends the two children of inner binary node n, checked.
+  void open(std::uint32_t n, SlotList& slots) {
+    check_children(n);
+    for (std::uint32_t c : tree_.nodes[n].child) slots.push_back(slot_of(c));
+  }
+
+  // Appends binary node m's subtree as at most `budget` slots, as planned.
+  void distribute(std::uint32_t m, int budget, SlotList& slots) {
+    const auto [left, right] = plan_.split(m, budget);
+    const BuildNode& b = tree_.nodes[m];
+    if (left > 0) {
+      check_children(m);
+      distribute(b.child[0], left, slots);
+      distribute(b.child[1], right, slots);
+    } else if (b.is_leaf() || !plan_.is_block(m)) {
+      slots.push_back(slot_of(m));
+    } else {
+      Slot group;
+      add_to_group(m, group);
+      slots.push_back(group);
+    }
+  }
+
+  // Adds the binary leaves of m's subtree (at most eight primitives, as
+  // planned) to the leaf group `group`, checked.
+  void add_to_group(std::uint32_t m, Slot& group) {
+    const BuildNode& b = tree_.nodes[m];
+    if (!b.is_leaf()) {
+      check_children(m);
+      add_to_group(b.child[0], group);
+      add_to_group(b.child[1], group);
+      return;
+    }
+    const Slot s = slot_of(m);
+    if (group.leaf_count == 0) {
+      group = s;
+      return;
+    }
+    group.bounds = merge(group.bounds, s.bounds);
+    group.count += s.count;
+    group.leaves[group.leaf_count++] = m;
   }
 
   // Merges the pair of leaf groups whose union saves the most area (SAH:
@@ -521,7 +579,9 @@ class Flattener {
   const BuildTree& tree_;
   const Geometry& geometry_;
   bool merge_leaves_;
-  bool split_references_;  // a triangle may sit in several leaves (bvh_presplit.hpp)
+  bool split_references_;
+  std::uint32_t greedy_levels_;
+  CollapsePlan plan_;  // a triangle may sit in several leaves (bvh_presplit.hpp)
   unsigned threads_ = 1;
   std::vector<std::atomic<std::uint8_t>> node_seen_;  // by the walks, on several threads
   std::vector<BlockSource> triangle_sources_, sphere_sources_;  // per block of out_.blocks, same order
@@ -531,9 +591,8 @@ class Flattener {
 
 }  // namespace
 
-Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, bool merge_leaves, unsigned thread_count,
-                  bool split_references) {
-  return Flattener(tree, geometry, merge_leaves, thread_count, split_references).run();
+Bvh8 flatten_bvh8(const BuildTree& tree, const Geometry& geometry, const FlattenOptions& options) {
+  return Flattener(tree, geometry, options).run();
 }
 
 }  // namespace rtcl

@@ -81,7 +81,7 @@ std::unique_ptr<Accel> make_bvh_mixed(const Device& device, const Geometry& geom
   costs.obb = static_cast<float>(o.real("obb_cost"));
   costs.block = static_cast<float>(o.real("block_cost"));
   GeometryReport report = validate(geometry);
-  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, bvh_config), geometry, bvh_config);
+  Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, bvh_config), geometry, flatten_options(bvh_config));
   BvhVolumeFilters filters = choose_volume_filters(bvh, costs, geometry.source);
   AccelStats stats = bvh_stats(geometry, report, bvh, start);
   stats.device_bytes += filters.device_bytes();

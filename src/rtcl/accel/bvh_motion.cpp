@@ -156,7 +156,7 @@ std::unique_ptr<MotionBvh::Data> build(const Geometry& open, const Geometry& clo
   SahConfig sah;
   BuildTree tree = join(build_sah(all_bounds.first(first_sphere), all_ids.first(first_sphere), sah),
                         build_sah(all_bounds.subspan(first_sphere), all_ids.subspan(first_sphere), sah));
-  data->bvh = flatten_bvh8(tree, open, true);
+  data->bvh = flatten_bvh8(tree, open);
   // The close keyframe in the same blocks and lanes.
   for (const TriangleBlock& b : data->bvh.blocks.triangles) {
     std::vector<std::uint32_t> prims;
