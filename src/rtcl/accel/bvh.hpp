@@ -55,9 +55,10 @@ struct BvhConfig {
   // eight children; below them each wide node takes the SAH-optimal layout
   // of its subtree (bvh_collapse.hpp). 0: optimal throughout; a level
   // beyond the tree's depth: greedy throughout. Measured (README "The
-  // collapse into wide nodes"): 2 traced the twelve bench/ sets 1-9% faster
-  // than greedy throughout (medians of two runs); optimal throughout lost
-  // 4-12% on sponza's primary rays.
+  // collapse into wide nodes", 11 rounds, medians): 2 traced eleven of the
+  // twelve bench/ sets 1-5% faster than greedy throughout (two earlier runs:
+  // 1-10%); optimal throughout traced sponza's primary rays 1-12% slower
+  // than greedy over four runs.
   std::uint32_t greedy_levels = 2;
   // Early split clipping (bvh_presplit.hpp): triangles whose box's surface
   // area exceeds presplit times the mean enter the builder as several
