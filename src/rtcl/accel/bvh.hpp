@@ -56,7 +56,7 @@ struct BvhConfig {
   // of its subtree (bvh_collapse.hpp). 0: optimal throughout; a level
   // beyond the tree's depth: greedy throughout. Measured (README "The
   // collapse into wide nodes", 11 rounds, medians): 2 traced eleven of the
-  // twelve bench/ sets 1-5% faster than greedy throughout (two earlier runs:
+  // twelve bench/ sets up to 5% faster than greedy throughout (two earlier runs:
   // 1-10%); optimal throughout traced sponza's primary rays 1-12% slower
   // than greedy over four runs.
   std::uint32_t greedy_levels = 2;
