@@ -1,19 +1,18 @@
 // flatten_bvh8 (bvh.hpp): the binary build tree collapsed into 8-wide nodes
 // and primitive blocks, in three passes.
 //
-// 1. Walk: wide nodes are formed depth first: those of the top
-//    greedy_levels wide levels by opening the child of largest area until
-//    eight, those below by the SAH-optimal plan (bvh_collapse.hpp). A wide
-//    node's inner children
-//    get consecutive indices when it is formed, and the first child's
-//    subtree is formed before the second's; blocks are numbered in the order
-//    their wide nodes are formed. A block is recorded as its lanes'
-//    primitive ids and binary leaves; the walk reads the tree, never the
-//    geometry. Trees of kSplitMinNodes binary nodes and more are walked in
-//    parts: the top kSplitDepth - 1 wide levels first, then each subtree
-//    below them on whichever thread is free, each part's nodes and blocks
-//    placed after the top's in the order the top met them, so that the
-//    result does not depend on the threads.
+// 1. Walk: wide nodes are formed depth first: those of the top greedy_levels
+//    wide levels by opening the child of largest area until eight, those below
+//    by the SAH-optimal plan (bvh_collapse.hpp). A wide node's inner children
+//    get consecutive indices when it is formed, and the first child's subtree
+//    is formed before the second's; blocks are numbered in the order their wide
+//    nodes are formed. A block is recorded as its lanes' primitive ids and
+//    binary leaves; the walk reads the tree, never the geometry. Trees of
+//    kSplitMinNodes binary nodes and more are walked in parts: the top
+//    kSplitDepth - 1 wide levels first, then each subtree below them on
+//    whichever thread is free, each part's nodes and blocks placed after the
+//    top's in the order the top met them, so that the result does not depend on
+//    the threads.
 // 2. Gather (block ranges on parallel threads): each block is filled from the
 //    geometry, every primitive's vertices read once and checked there: inside
 //    its binary leaf's box, not a zero-area triangle, not marked before by
