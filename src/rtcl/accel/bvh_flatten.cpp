@@ -578,9 +578,9 @@ class Flattener {
   const BuildTree& tree_;
   const Geometry& geometry_;
   bool merge_leaves_;
-  bool split_references_;
+  bool split_references_;  // a triangle may sit in several leaves (bvh_presplit.hpp)
   std::uint32_t greedy_levels_;
-  CollapsePlan plan_;  // a triangle may sit in several leaves (bvh_presplit.hpp)
+  CollapsePlan plan_;  // the layout below the greedy levels
   unsigned threads_ = 1;
   std::vector<std::atomic<std::uint8_t>> node_seen_;  // by the walks, on several threads
   std::vector<BlockSource> triangle_sources_, sphere_sources_;  // per block of out_.blocks, same order
