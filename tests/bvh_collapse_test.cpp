@@ -26,15 +26,6 @@ double area(const Aabb& b) {
   return 2.0 * (dx * dy + dy * dz + dz * dx);
 }
 
-Aabb lane_box(const Bvh8Node& node, int lane) {
-  Aabb box;
-  for (int a = 0; a < 3; ++a) {
-    box.lower[a] = node.bounds[a][lane];
-    box.upper[a] = node.bounds[3 + a][lane];
-  }
-  return box;
-}
-
 // The surface-area cost of a flattened tree from its wide nodes alone: each
 // wide node's test (kCollapseNodeCost) and each block's (1), weighted by the
 // area of the box its parent's lane gives it (the root's: the union of its
@@ -44,7 +35,7 @@ double layout_cost(const Bvh8& bvh) {
   std::vector<std::pair<rtcl_i32, double>> todo;
   Aabb root;
   for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
-    if (bvh.nodes[0].child[lane] != RTCL_CHILD_EMPTY) root.grow(lane_box(bvh.nodes[0], lane));
+    if (bvh.nodes[0].child[lane] != RTCL_CHILD_EMPTY) root.grow(bvh8_lane_box(bvh.nodes[0], lane));
   todo.push_back({0, area(root)});
   while (!todo.empty()) {
     const auto [ref, box_area] = todo.back();
@@ -56,7 +47,7 @@ double layout_cost(const Bvh8& bvh) {
     cost += kCollapseNodeCost * box_area;
     const Bvh8Node& node = bvh.nodes[static_cast<std::size_t>(ref)];
     for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
-      if (node.child[lane] != RTCL_CHILD_EMPTY) todo.push_back({node.child[lane], area(lane_box(node, lane))});
+      if (node.child[lane] != RTCL_CHILD_EMPTY) todo.push_back({node.child[lane], area(bvh8_lane_box(node, lane))});
   }
   return cost;
 }

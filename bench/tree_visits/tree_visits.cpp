@@ -84,24 +84,18 @@ Visits ideal_visits(const Bvh8& bvh, const Ray& ray, double t_end) {
   return v;
 }
 
-// Lane k's box of `node`.
-Aabb lane_box(const Bvh8Node& node, int k) {
-  return {{node.bounds[0][k], node.bounds[1][k], node.bounds[2][k]},
-          {node.bounds[3][k], node.bounds[4][k], node.bounds[5][k]}};
-}
-
 // The wide tree's SAH cost relative to the root box, and its blocks' filled lanes.
 void tree_cost(const Bvh8& bvh, double* cost, double* lanes_per_block) {
   Aabb root;
   for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k)
-    if (bvh.nodes[0].child[k] != RTCL_CHILD_EMPTY) root.grow(lane_box(bvh.nodes[0], k));
+    if (bvh.nodes[0].child[k] != RTCL_CHILD_EMPTY) root.grow(bvh8_lane_box(bvh.nodes[0], k));
   const double root_area = root.area();
   double area = 0.5 * root_area, blocks = 0, lanes = 0;
   for (const Bvh8Node& node : bvh.nodes)
     for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
       const rtcl_i32 child = node.child[k];
       if (child == RTCL_CHILD_EMPTY) continue;
-      area += (child >= 0 ? 0.5 : 1.0) * lane_box(node, k).area();
+      area += (child >= 0 ? 0.5 : 1.0) * bvh8_lane_box(node, k).area();
       if (child < 0 && (~child & 1) == 0) {
         const TriangleBlock& block = bvh.blocks.triangles[static_cast<std::size_t>(~child >> 1)];
         blocks += 1;

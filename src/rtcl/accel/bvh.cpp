@@ -148,6 +148,11 @@ unsigned bvh_thread_count(const BvhConfig& config) {
   return config.builder == BvhBuilder::ploc ? config.ploc.thread_count : config.sah.thread_count;
 }
 
+Aabb bvh8_lane_box(const Bvh8Node& node, int lane) {
+  return {{node.bounds[0][lane], node.bounds[1][lane], node.bounds[2][lane]},
+          {node.bounds[3][lane], node.bounds[4][lane], node.bounds[5][lane]}};
+}
+
 FlattenOptions flatten_options(const BvhConfig& config) {
   return {.merge_leaves = config.merge_leaves,
           .thread_count = bvh_thread_count(config),

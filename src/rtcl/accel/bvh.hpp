@@ -96,6 +96,10 @@ struct Bvh8 {
   std::uint32_t depth = 0;       // wide levels on the longest root-to-leaf path
 };
 
+// The box of `node`'s lane `lane` (0..7); an empty slot's is empty (lower
+// +inf, upper -inf).
+Aabb bvh8_lane_box(const Bvh8Node& node, int lane);
+
 // The binary tree over the geometry's stored primitives (zero-area
 // triangles skipped); leaves hold primitive ids. Triangles and spheres are
 // built separately and joined under one root, so no leaf mixes them.

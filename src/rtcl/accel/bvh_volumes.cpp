@@ -45,11 +45,6 @@ bool collect_vertices(const Bvh8& bvh, rtcl_i32 ref, std::vector<glm::vec3>& poi
   return !points.empty();
 }
 
-Aabb lane_box(const Bvh8Node& node, int lane) {
-  return {{node.bounds[0][lane], node.bounds[1][lane], node.bounds[2][lane]},
-          {node.bounds[3][lane], node.bounds[4][lane], node.bounds[5][lane]}};
-}
-
 double box_area(const Aabb& b) {
   if (b.empty()) return 0.0;
   glm::dvec3 e = glm::dvec3(b.upper) - glm::dvec3(b.lower);
@@ -108,7 +103,7 @@ BvhVolumeFilters choose_volume_filters(const Bvh8& bvh, const VolumeCosts& costs
     for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
       rtcl_i32 child = node.child[lane];
       if (child == RTCL_CHILD_EMPTY) continue;
-      Aabb box = lane_box(node, lane);
+      Aabb box = bvh8_lane_box(node, lane);
       auto& area = t.slot_area[static_cast<std::size_t>(lane)];
       area.fill(box_area(box));
       if (collect_vertices(bvh, child, points)) {
@@ -127,7 +122,7 @@ BvhVolumeFilters choose_volume_filters(const Bvh8& bvh, const VolumeCosts& costs
   // Top-down: each node's option at the area its parent's choice gives it.
   Aabb root_box;
   for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
-    if (bvh.nodes[0].child[lane] != RTCL_CHILD_EMPTY) root_box.grow(lane_box(bvh.nodes[0], lane));
+    if (bvh.nodes[0].child[lane] != RTCL_CHILD_EMPTY) root_box.grow(bvh8_lane_box(bvh.nodes[0], lane));
   double a_root = box_area(root_box);
   std::vector<double> entering(bvh.nodes.size(), 0.0);
   entering[0] = a_root;
