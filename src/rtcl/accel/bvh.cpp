@@ -215,7 +215,7 @@ OptionSpec node_cost_option() {
 OptionSpec presplit_option() {
   return {"presplit", OptionType::real, 0.0, 0, 1024, false,
           "split the references of triangles whose box's area exceeds presplit x the mean (0 = off): at 16 "
-          "sponza's primary rays 1.13-1.16x faster, diffuse bounces 0.97-0.99x, 3-13% more build time"};
+          "sponza's primary rays 1.08-1.16x faster, diffuse bounces 0.97-1.03x, 3-13% more build time"};
 }
 OptionSpec max_leaf_size_option() {
   return {"max_leaf_size", OptionType::integer, std::int64_t{8}, 1, 8, false,

@@ -65,8 +65,9 @@ struct BvhConfig {
   // area exceeds presplit times the mean enter the builder as several
   // references; 0 = off (the default). Measured (README "Build options
   // against trace speed"): 16 traced the single-ray primary rays of sponza
-  // 1.13-1.16x and of sibenik 1.03-1.04x faster, their diffuse bounces
-  // 0.97-0.99x, built sponza in 3-13% more time, split no triangle of the
+  // 1.13-1.16x and of sibenik 1.03-1.04x faster on the greedy collapse, and
+  // 1.08x and 1.07x on the default collapse (one run), their diffuse bounces
+  // 0.97-1.03x, built sponza in 3-13% more time, split no triangle of the
   // bunny and added 9 references to the dragon's 100,000.
   float presplit = 0.0f;
   // Occlusion (Query::any): consecutive rays per work-item (packets of 8 in
