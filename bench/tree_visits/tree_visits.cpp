@@ -12,8 +12,11 @@
 // and the diffuse bounces of the bench/ camera ($RTCL_BENCH_RES, default
 // 256), the wide nodes, blocks and triangles an ideal traversal of each
 // ray's segment [tmin, t_hit] tests: every node and block whose box the
-// segment meets (in double precision), as the SAH assumes. t_hit is the
+// segment meets (in double precision), as the SAH assumes, and the share of
+// those wide nodes whose box test lets 0, 1, 2 and 3 or more children
+// through (the branches a traversal takes after each node). t_hit is the
 // first tree's closest hit, traced by its kernel on the default device.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -38,6 +41,7 @@ using namespace rtcl::bench;
 
 struct Visits {
   double nodes = 0, blocks = 0, triangles = 0;
+  double entered[4] = {};  // wide nodes that let 0, 1, 2, 3 or more children through
 };
 
 // Whether the segment [tmin, t_end] of `ray` meets lane k's box of `node`
@@ -67,9 +71,11 @@ Visits ideal_visits(const Bvh8& bvh, const Ray& ray, double t_end) {
     const Bvh8Node& node = bvh.nodes[static_cast<std::size_t>(stack.back())];
     stack.pop_back();
     v.nodes += 1;
+    int entered = 0;
     for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
       const rtcl_i32 child = node.child[k];
       if (child == RTCL_CHILD_EMPTY || !segment_meets(ray, t_end, node, k)) continue;
+      ++entered;
       if (child >= 0) {
         stack.push_back(child);
         continue;
@@ -80,6 +86,7 @@ Visits ideal_visits(const Bvh8& bvh, const Ray& ray, double t_end) {
         for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) v.triangles += block.prim[lane] >= 0;
       }
     }
+    v.entered[std::min(entered, 3)] += 1;
   }
   return v;
 }
@@ -157,9 +164,13 @@ int run(int argc, char** argv) {
           const double t_end = set.hits[i].prim >= 0 ? set.hits[i].t : set.rays[i].tmax;
           const Visits v = ideal_visits(bvh, set.rays[i], t_end);
           total.nodes += v.nodes, total.blocks += v.blocks, total.triangles += v.triangles;
+          for (int c = 0; c < 4; ++c) total.entered[c] += v.entered[c];
         }
         const double n = static_cast<double>(set.rays.size());
         std::printf("  | %s %5.2f / %4.2f / %5.2f", set.name, total.nodes / n, total.blocks / n, total.triangles / n);
+        std::printf(" (entering 0/1/2/3+: %.0f/%.0f/%.0f/%.0f%%)", 100 * total.entered[0] / total.nodes,
+                    100 * total.entered[1] / total.nodes, 100 * total.entered[2] / total.nodes,
+                    100 * total.entered[3] / total.nodes);
       }
       std::printf("\n");
     }
