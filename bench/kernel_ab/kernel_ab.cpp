@@ -32,7 +32,10 @@
 //
 // Environment: AB_ACCEL (structure, default bvh), AB_NO_EMBREE (set: no
 // Embree), AB_SETS (the ray sets to time, e.g. "primary,shadow"; default
-// all three), RTCL_BENCH_RES, RTCL_SCENES_DIR, RTCL_DEVICE.
+// all three), AB_MORTON_ORDER (set: every timed set traced, by every
+// version and Embree, in the host's Morton order of render/ray_order.hpp
+// instead of the camera's row order), RTCL_BENCH_RES, RTCL_SCENES_DIR,
+// RTCL_DEVICE.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -52,6 +55,7 @@
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/geometry.hpp"
+#include "rtcl/render/ray_order.hpp"
 
 #include "../ab_support.hpp"
 #ifdef RTCL_HAVE_EMBREE
@@ -96,6 +100,7 @@ int run(int argc, char** argv) {
       throw Error("AB_SETS: unknown ray set '" + name + "' (known: primary, shadow, diffuse)");
 #ifdef RTCL_HAVE_EMBREE
   const bool use_embree = std::getenv("AB_NO_EMBREE") == nullptr;
+  const bool morton = std::getenv("AB_MORTON_ORDER") != nullptr;
 #endif
 
   Device device = Device::open();
@@ -149,7 +154,8 @@ int run(int argc, char** argv) {
 #endif
     for (const Set& set : sets) {
       if (std::find(timed_sets.begin(), timed_sets.end(), set.name) == timed_sets.end()) continue;
-      const std::vector<Ray>& rays = *set.rays;
+      const std::vector<Ray> rays =
+          morton ? gather<Ray>(*set.rays, morton_order(*set.rays, geometry.bounds())) : *set.rays;
       std::vector<Hit> first, other;
       launch(0, set.query, rays, &first);
       for (std::size_t v = 1; v < versions.size(); ++v) {
