@@ -98,9 +98,9 @@ int run(int argc, char** argv) {
   for (const std::string& name : timed_sets)
     if (name != "primary" && name != "shadow" && name != "diffuse")
       throw Error("AB_SETS: unknown ray set '" + name + "' (known: primary, shadow, diffuse)");
+  const bool morton = std::getenv("AB_MORTON_ORDER") != nullptr;
 #ifdef RTCL_HAVE_EMBREE
   const bool use_embree = std::getenv("AB_NO_EMBREE") == nullptr;
-  const bool morton = std::getenv("AB_MORTON_ORDER") != nullptr;
 #endif
 
   Device device = Device::open();
@@ -154,8 +154,9 @@ int run(int argc, char** argv) {
 #endif
     for (const Set& set : sets) {
       if (std::find(timed_sets.begin(), timed_sets.end(), set.name) == timed_sets.end()) continue;
-      const std::vector<Ray> rays =
-          morton ? gather<Ray>(*set.rays, morton_order(*set.rays, geometry.bounds())) : *set.rays;
+      std::vector<Ray> morton_rays;
+      if (morton) morton_rays = gather<Ray>(*set.rays, morton_order(*set.rays, geometry.bounds()));
+      const std::vector<Ray>& rays = morton ? morton_rays : *set.rays;
       std::vector<Hit> first, other;
       launch(0, set.query, rays, &first);
       for (std::size_t v = 1; v < versions.size(); ++v) {
