@@ -22,14 +22,16 @@ primary run, which must be among the files (same image size).
 
 Events (callgrind's models, not this host's counters): Ir instructions, Bc
 / Bcm conditional branches / those its simple predictor mispredicts, D1mr
-first-level data read misses (32 KiB, 8-way); "-" where the run did not
-simulate them.
+first-level data read misses (32 KiB, 8-way), DLmr last-level data read
+misses (the size --LL gives: --LL=524288,8,64 models this host's 512 KiB
+second-level cache, whose misses go to the 32 MiB third level); "-" where
+the run did not simulate them.
 """
 import collections
 import re
 import sys
 
-EVENTS = ("Ir", "Bc", "Bcm", "D1mr")
+EVENTS = ("Ir", "Bc", "Bcm", "D1mr", "DLmr")
 
 
 class Run:
