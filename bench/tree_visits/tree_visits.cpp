@@ -8,7 +8,9 @@
 // (bvh, bvh-ploc, bvh-packet). Per scene and tree it prints the wide
 // nodes, the leaf blocks and their filled lanes, the tree's SAH cost (the
 // surface area of every wide node's box x 0.5 plus every block's x 1,
-// over the root's: the builder's cost model), and, for the primary rays
+// over the root's: the builder's cost model) with its two sums apart (the
+// wide nodes and the blocks a line through the root box meets, on
+// average), and, for the primary rays
 // and the diffuse bounces of the bench/ camera ($RTCL_BENCH_RES, default
 // 256), the wide nodes, blocks and triangles an ideal traversal of each
 // ray's segment [tmin, t_hit] tests: every node and block whose box the
@@ -91,26 +93,40 @@ Visits ideal_visits(const Bvh8& bvh, const Ray& ray, double t_end) {
   return v;
 }
 
-// The wide tree's SAH cost relative to the root box, and its blocks' filled lanes.
-void tree_cost(const Bvh8& bvh, double* cost, double* lanes_per_block) {
+// The wide tree's expected work for a line through the root box (the SAH's
+// assumption): the wide nodes it visits (every node's box area, the root's
+// included, over the root's) and the leaf blocks it tests (their boxes'
+// areas over the root's); the builder's SAH cost, 0.5 x nodes + 1 x blocks;
+// and the blocks' filled lanes. The first two are what Embree's BVH
+// statistics (its device config verbose=3) print as the inner nodes' and
+// leaves' SAH, with its cost factors of 1.
+struct TreeCost {
+  double node_visits = 0, block_tests = 0, lanes_per_block = 0;
+  double sah() const { return 0.5 * node_visits + block_tests; }
+};
+
+TreeCost tree_cost(const Bvh8& bvh) {
   Aabb root;
   for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k)
     if (bvh.nodes[0].child[k] != RTCL_CHILD_EMPTY) root.grow(bvh8_lane_box(bvh.nodes[0], k));
   const double root_area = root.area();
-  double area = 0.5 * root_area, blocks = 0, lanes = 0;
+  double node_area = root_area, block_area = 0, blocks = 0, lanes = 0;
   for (const Bvh8Node& node : bvh.nodes)
     for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
       const rtcl_i32 child = node.child[k];
       if (child == RTCL_CHILD_EMPTY) continue;
-      area += (child >= 0 ? 0.5 : 1.0) * bvh8_lane_box(node, k).area();
+      (child >= 0 ? node_area : block_area) += bvh8_lane_box(node, k).area();
       if (child < 0 && (~child & 1) == 0) {
         const TriangleBlock& block = bvh.blocks.triangles[static_cast<std::size_t>(~child >> 1)];
         blocks += 1;
         for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) lanes += block.prim[lane] >= 0;
       }
     }
-  *cost = area / root_area;
-  *lanes_per_block = blocks > 0 ? lanes / blocks : 0.0;
+  TreeCost cost;
+  cost.node_visits = node_area / root_area;
+  cost.block_tests = block_area / root_area;
+  cost.lanes_per_block = blocks > 0 ? lanes / blocks : 0.0;
+  return cost;
 }
 
 int run(int argc, char** argv) {
@@ -154,10 +170,10 @@ int run(int argc, char** argv) {
       config.options = accel_spec.options;
       const BvhConfig bvh_config = resolve_bvh_config(structure_spec(accel_spec.name), config);
       const Bvh8 bvh = flatten_bvh8(build_binary_bvh(geometry, bvh_config), geometry, flatten_options(bvh_config));
-      double cost = 0, lanes = 0;
-      tree_cost(bvh, &cost, &lanes);
-      std::printf("  %-22s %6zu nodes %6zu blocks %.2f lanes/block  SAH cost %6.2f", argv[s], bvh.nodes.size(),
-                  bvh.blocks.triangles.size(), lanes, cost);
+      const TreeCost cost = tree_cost(bvh);
+      std::printf("  %-22s %6zu nodes %6zu blocks %.2f lanes/block  SAH cost %6.2f (%.2f nodes + %.2f blocks)",
+                  argv[s], bvh.nodes.size(), bvh.blocks.triangles.size(), cost.lanes_per_block, cost.sah(),
+                  cost.node_visits, cost.block_tests);
       for (const auto& set : sets) {
         Visits total;
         for (std::size_t i = 0; i < set.rays.size(); ++i) {

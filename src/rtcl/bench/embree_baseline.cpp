@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <mutex>
 #include <thread>
@@ -27,10 +28,13 @@ bool monitor_memory(void*, ssize_t bytes, bool) {
 }
 
 // One Embree device per process; its TBB arena gets the first caller's
-// thread count.
+// thread count. $RTCL_EMBREE_CONFIG, where set, is appended to the device's
+// configuration (Embree's rtcNewDevice syntax; e.g. verbose=3 prints the
+// statistics of every BVH it builds).
 RTCDevice embree_device(unsigned threads) {
   static RTCDevice device = [threads] {
     std::string config = "threads=" + std::to_string(std::max(threads, 1u));
+    if (const char* extra = std::getenv("RTCL_EMBREE_CONFIG"); extra && *extra) config += std::string(",") + extra;
     RTCDevice d = rtcNewDevice(config.c_str());
     if (!d) throw Error("Embree: rtcNewDevice(\"" + config + "\") failed (error " +
                         std::to_string(rtcGetDeviceError(nullptr)) + ")");
