@@ -54,8 +54,8 @@
 #include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/error.hpp"
-#include "rtcl/scene/geometry.hpp"
 #include "rtcl/render/ray_order.hpp"
+#include "rtcl/scene/geometry.hpp"
 
 #include "../ab_support.hpp"
 #ifdef RTCL_HAVE_EMBREE

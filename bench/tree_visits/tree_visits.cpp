@@ -44,6 +44,12 @@ using namespace rtcl::bench;
 struct Visits {
   double nodes = 0, blocks = 0, triangles = 0;
   double entered[4] = {};  // wide nodes that let 0, 1, 2, 3 or more children through
+
+  Visits& operator+=(const Visits& o) {
+    nodes += o.nodes, blocks += o.blocks, triangles += o.triangles;
+    for (int c = 0; c < 4; ++c) entered[c] += o.entered[c];
+    return *this;
+  }
 };
 
 // Whether the segment [tmin, t_end] of `ray` meets lane k's box of `node`
@@ -178,9 +184,7 @@ int run(int argc, char** argv) {
         Visits total;
         for (std::size_t i = 0; i < set.rays.size(); ++i) {
           const double t_end = set.hits[i].prim >= 0 ? set.hits[i].t : set.rays[i].tmax;
-          const Visits v = ideal_visits(bvh, set.rays[i], t_end);
-          total.nodes += v.nodes, total.blocks += v.blocks, total.triangles += v.triangles;
-          for (int c = 0; c < 4; ++c) total.entered[c] += v.entered[c];
+          total += ideal_visits(bvh, set.rays[i], t_end);
         }
         const double n = static_cast<double>(set.rays.size());
         std::printf("  | %s %5.2f / %4.2f / %5.2f", set.name, total.nodes / n, total.blocks / n, total.triangles / n);
