@@ -71,6 +71,7 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
     // occlusion in runs: every shadow cell on a CPU device, no other cell
     const bool runs = cell["rays"] == "shadow" && json["devices"][0]["type"] == "cpu";
     EXPECT_EQ(cell["occluder_run"].get<int>(), runs ? 16 : 1) << cell.dump();
+    EXPECT_FALSE(cell["sorted"].get<bool>()) << "sorted without --sort-diffuse: " << cell.dump();
     ASSERT_TRUE(cell.contains("embree"));
 #ifdef RTCL_TESTS_EXPECT_EMBREE
     // packets against packets: the packet kernel is compared with rtcIntersect8 / rtcOccluded8
@@ -112,6 +113,30 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
   EXPECT_EQ(seen.size(), json["cells"].size());
   std::string md = read_text(dir.file("out/bench.md"));
   EXPECT_NE(md.find("| tetra:levels=2 | grid |"), std::string::npos) << md;
+}
+
+// --sort-diffuse: the diffuse cells of structures whose scattered calls sort
+// (single-ray kernels on a CPU device) are sorted, agree with brute force
+// and say so; no other cell is.
+TEST(CliBench, SortDiffuseSortsOnlyTheDiffuseCellsThatCan) {
+  TempDir dir;
+  CliRun run = run_cli(dir,
+                       {"bench", "--size", "32", "--scene", "bunny", "--accel", "bvh,bvh-packet,grid", "--rays",
+                        "primary,diffuse", "--repeat", "1", "--check-rays", "64", "--device", "0", "--sort-diffuse",
+                        "-o", dir.file("out")},
+                       scenes_env());
+  ASSERT_EQ(run.status, 0) << run.err;
+  nlohmann::json json = nlohmann::json::parse(read_text(dir.file("out/bench.json")));
+  EXPECT_TRUE(json["options"]["sort_diffuse"].get<bool>());
+  const bool cpu = json["devices"][0]["type"] == "cpu";
+  ASSERT_EQ(json["cells"].size(), 6u);
+  for (const auto& cell : json["cells"]) {
+    const bool sorts = cpu && cell["rays"] == "diffuse" && cell["accel"] != "bvh-packet";
+    EXPECT_EQ(cell["sorted"].get<bool>(), sorts) << cell.dump();
+    EXPECT_TRUE(cell["check"]["ok"].get<bool>()) << cell.dump();
+  }
+  std::string md = read_text(dir.file("out/bench.md"));
+  if (cpu) EXPECT_NE(md.find(" sorted "), std::string::npos) << md;
 }
 
 // --precision sets every structure's level and --embree-robust Embree's

@@ -157,8 +157,9 @@ TEST(Cli, RepeatedTraceReportsMinMedianMaxAndMatchesTheReference) {
 
 // --coherent: the default structure traces 8-ray packets on a CPU device
 // and one ray per work-item on others (packets_for_coherent_calls); the
-// answers stay the reference's. Without it, one ray per work-item
-// (occlusion: in runs).
+// answers stay the reference's. --scattered: sorted on the device first
+// on a CPU device, the answers the reference's; not with --coherent.
+// Without either, one ray per work-item (occlusion: in runs).
 TEST(Cli, CoherentTraceUsesPacketsAndMatchesTheReference) {
   Inputs in;
   Geometry g = load_mesh(in.mesh).geometry;
@@ -176,6 +177,23 @@ TEST(Cli, CoherentTraceUsesPacketsAndMatchesTheReference) {
     auto report = judge_all(g, in.ray_list, hits, any ? Query::any : Query::closest, &failures);
     EXPECT_EQ(failures, 0u) << (report.empty() ? "" : report[0]) << " (any " << any << ")";
   }
+  // --scattered: sorted first on a CPU device, answers the reference's
+  const bool sorts = test_device().info().type == "cpu";
+  for (bool any : {false, true}) {
+    std::vector<std::string> args = {"trace", in.mesh, in.rays, "-o", "out.hits", "--scattered", "--repeat", "2"};
+    if (any) args.push_back("--any");
+    CliRun run = run_cli(in.dir, args);
+    ASSERT_EQ(run.status, 0) << run.err;
+    EXPECT_EQ(run.out.find("sorted on the device, then one ray per work-item") != std::string::npos, sorts)
+        << run.out;
+    std::size_t failures = 0;
+    auto report = judge_all(g, in.ray_list, read_hits(in.dir.file("out.hits")), any ? Query::any : Query::closest,
+                            &failures);
+    EXPECT_EQ(failures, 0u) << (report.empty() ? "" : report[0]) << " (any " << any << ")";
+  }
+  CliRun both = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits", "--coherent", "--scattered"});
+  EXPECT_NE(both.status, 0);
+  EXPECT_NE(both.err.find("--scattered"), std::string::npos) << both.err;
   CliRun plain = run_cli(in.dir, {"trace", in.mesh, in.rays, "-o", "out.hits"});
   ASSERT_EQ(plain.status, 0) << plain.err;
   EXPECT_NE(plain.out.find("one ray per work-item"), std::string::npos) << plain.out;

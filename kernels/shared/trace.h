@@ -32,18 +32,29 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
 #define RTCL_TRACE_KERNEL_NAME(NAME) trace_closest_##NAME
 #endif
 
+/* With RTCL_TRACE_ORDER (a Coherence::scattered call, kernels/accel/ray_sort.cl)
+ * the kernel takes `global const uint* order` after ray_count: rays[k] is
+ * the caller's ray order[k], and its hit goes to hits[order[k]]. */
+#ifdef RTCL_TRACE_ORDER
+#define RTCL_TRACE_ORDER_PARAM global const uint *order,
+#define RTCL_TRACE_HIT_INDEX(k) order[k]
+#else
+#define RTCL_TRACE_ORDER_PARAM
+#define RTCL_TRACE_HIT_INDEX(k) (k)
+#endif
+
 /* Defines the kernel from an inline function
  * NAME_traverse(const TraceRay*, HitState*, STRUCTURE_PARAMS...), which
  * ends at its first hit when RTCL_ANY_HIT is 1. */
 #define RTCL_TRACE_KERNELS(NAME, PARAMS, ARGS)                                                      \
   kernel void RTCL_TRACE_KERNEL_NAME(NAME)(global const Ray* rays, global Hit* hits, uint ray_count, \
-                                           PARAMS) {                                                 \
+                                           RTCL_TRACE_ORDER_PARAM PARAMS) {                          \
     uint i = get_global_id(0);                                                                      \
     if (i >= ray_count) return;                                                                     \
     TraceRay s;                                                                                     \
     HitState h;                                                                                     \
     if (begin_trace(rays, i, &s, &h)) NAME##_traverse(&s, &h, ARGS);                                \
-    end_trace(hits, i, &h);                                                                         \
+    end_trace(hits, RTCL_TRACE_HIT_INDEX(i), &h);                                                   \
   }
 
 /* RTCL_TRACE_KERNELS for a structure whose any-hit traversal reports the
@@ -61,7 +72,8 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
  * RTCL_TRACE_KERNELS's. */
 #ifdef RTCL_QUERY_ANY
 #define RTCL_TRACE_KERNELS_OCCLUDER_CACHE(NAME, PARAMS, ARGS)                                        \
-  kernel void trace_any_##NAME(global const Ray* rays, global Hit* hits, uint ray_count, PARAMS) {    \
+  kernel void trace_any_##NAME(global const Ray* rays, global Hit* hits, uint ray_count,              \
+                               RTCL_TRACE_ORDER_PARAM PARAMS) {                                      \
     ulong run = ((ulong)ray_count + get_global_size(0) - 1) / get_global_size(0);                    \
     ulong first = get_global_id(0) * run;                                                             \
     if (first >= ray_count) return;                                                                   \
@@ -72,7 +84,7 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
       HitState h;                                                                                     \
       if (begin_trace(rays, i, &s, &h) && (occluder < 0 || !NAME##_leaf(occluder, &s, &h, ARGS)))     \
         occluder = NAME##_traverse(&s, &h, ARGS);                                                     \
-      end_trace(hits, i, &h);                                                                         \
+      end_trace(hits, RTCL_TRACE_HIT_INDEX(i), &h);                                                   \
     }                                                                                                 \
   }
 #else

@@ -179,8 +179,8 @@ std::size_t disagreeing(const std::vector<Hit>& hits, const SceneRays& rays, int
 // One cell: a warm-up launch, then `repeat` launches, each uploading the
 // rays, tracing and reading the hits back (wall) with the kernel's own time
 // from its profiling event.
-void measure(const Accel& accel, const SceneRays& rays, int kind, int repeat, const EmbreeBaseline* embree,
-             BenchCell& cell) {
+void measure(const Accel& accel, const SceneRays& rays, int kind, Coherence coherence, int repeat,
+             const EmbreeBaseline* embree, BenchCell& cell) {
   const std::vector<Ray>& set = rays.sets[kind];
   cell.ray_count = set.size();
   if (set.empty()) return;
@@ -192,21 +192,19 @@ void measure(const Accel& accel, const SceneRays& rays, int kind, int repeat, co
   cell.profiled = device.profiling();
   with_cl_errors([&] {
     Clock::time_point start = Clock::now();
-    accel.trace(query, ray_buffer, hit_buffer, set.size()).wait();
+    accel.trace(query, ray_buffer, hit_buffer, set.size(), {}, coherence).wait();
     cell.first_launch_ms = ms_since(start);
     for (int r = 0; r < repeat; ++r) {
       start = Clock::now();
       cl::Event written;
       device.queue().enqueueWriteBuffer(ray_buffer, CL_FALSE, 0, set.size() * sizeof(Ray), set.data(), nullptr,
                                         &written);
-      cl::Event done = accel.trace(query, ray_buffer, hit_buffer, set.size(), {written});
+      cl::Event done = accel.trace(query, ray_buffer, hit_buffer, set.size(), {written}, coherence);
       std::vector<cl::Event> wait{done};
       device.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits.size() * sizeof(Hit), hits.data(), &wait);
       cell.wall_ms.push_back(ms_since(start));
       double kernel = cell.wall_ms.back();
-      if (cell.profiled)
-        kernel = static_cast<double>(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
-                                     done.getProfilingInfo<CL_PROFILING_COMMAND_START>()) * 1e-6;
+      if (cell.profiled) kernel = accel.last_call_ms(done);
       cell.kernel_ms.push_back(kernel);
       if (embree) cell.embree_paired_ms.push_back(embree->trace_ms(query, cell.packets, set));
     }
@@ -237,6 +235,7 @@ BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) 
   } catch (const Error& e) {
     throw UsageError(e.what());
   }
+  m.sort_diffuse = options.sort_diffuse;
   m.json_path = options.output + "/bench.json";
   m.md_path = options.output + "/bench.md";
   if (create_output) {
@@ -268,6 +267,7 @@ BenchRun bench_run_header(const BenchOptions& options, const BenchMatrix& m) {
   run.check_rays = static_cast<std::size_t>(options.check_rays);
   run.precision = std::string(precision_name(m.precision));
   run.embree_flags = options.embree_robust ? "robust" : "none";
+  run.sort_diffuse = m.sort_diffuse;
   run.accels = m.accels;
   for (const BenchSceneSpec& s : m.scenes) run.scenes.push_back(s.text);
   for (int k : m.kinds) run.ray_kinds.push_back(kind_names[k]);
@@ -316,8 +316,10 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
     cell.primitives = stats.primitive_count;
     cell.packets = accel->rays_per_work_item(Coherence::incoherent) > 1;
     if (kind_query(k) == Query::any) cell.occluder_run = accel->occluder_run(Coherence::incoherent);
-    measure(*accel, *scene.rays, k, repeat, embree && (!cell.packets || embree->has_packets()) ? embree : nullptr,
-            cell);
+    Coherence coherence = k == 2 && matrix.sort_diffuse ? Coherence::scattered : Coherence::incoherent;
+    cell.sorted = accel->sorts(coherence);
+    measure(*accel, *scene.rays, k, coherence, repeat,
+            embree && (!cell.packets || embree->has_packets()) ? embree : nullptr, cell);
     cells.push_back(std::move(cell));
   }
   return cells;
@@ -437,6 +439,10 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--embree-robust", options->embree_robust,
                "build Embree's scenes with RTC_SCENE_FLAG_ROBUST (its watertight mode) instead of its default "
                "flags: the baseline for --precision robust or exact like for like");
+  cmd->add_flag("--sort-diffuse", options->sort_diffuse,
+               "trace the diffuse rays as scattered calls: structures with a single-ray kernel sort them on a CPU "
+               "device first, and their cells' times include the sort (README \"Scattered rays sorted on the "
+               "device\"); Embree traces them as they come");
   cmd->add_option("--embree-threads", options->embree_threads, "host threads Embree traces and builds on")
       ->check(CLI::Range(1u, 1024u))
       ->capture_default_str();

@@ -26,6 +26,7 @@ struct BenchOptions {
   std::string precision = "robust";  // every structure's level (AccelConfig::precision)
   bool no_embree = false;  // without Embree built in, there is no baseline either way
   bool embree_robust = false;  // Embree's scenes with RTC_SCENE_FLAG_ROBUST
+  bool sort_diffuse = false;   // diffuse rays traced as Coherence::scattered calls
   unsigned embree_threads = std::max(1u, std::thread::hardware_concurrency());
 };
 
@@ -35,6 +36,7 @@ struct BenchMatrix {
   std::vector<BenchSceneSpec> scenes;
   std::vector<int> kinds;  // 0 primary, 1 shadow, 2 diffuse
   Precision precision = Precision::robust;
+  bool sort_diffuse = false;  // BenchOptions::sort_diffuse
   std::string json_path, md_path;
 };
 

@@ -84,6 +84,7 @@ json cell_json(const BenchCell& c, const BenchBaseline* baseline) {
       {"first_launch_ms", c.first_launch_ms},
       {"packets", c.packets},
       {"occluder_run", c.occluder_run},
+      {"sorted", c.sorted},
       {"device_bytes", c.device_bytes},
       {"primitives", c.primitives},
       {"bytes_per_primitive",
@@ -134,6 +135,7 @@ std::string bench_json(const BenchRun& run) {
       {"options", {{"size", run.size}, {"repeat", run.repeat}, {"check_rays", run.check_rays},
                    {"accel", run.accels}, {"scene", run.scenes}, {"rays", run.ray_kinds},
                    {"precision", run.precision}, {"embree_flags", run.embree_flags},
+                   {"sort_diffuse", run.sort_diffuse},
                    {"pocl_cache_dir", run.pocl_cache_dir}}},
       {"devices", devices},
       {"scenes", scenes},
@@ -166,6 +168,9 @@ std::string bench_markdown(const BenchRun& run) {
                    " rays per primary set, median (min - max) Mrays/s of " + std::to_string(run.repeat) +
                    " kernel launches after a warm-up (OpenCL event times), precision " + run.precision +
                    "; build: host ms; B/prim: device bytes per primitive; check: rays agreeing with brute force" +
+                   (run.sort_diffuse ? "; diffuse rays traced as scattered calls: \"sorted\" cells include the "
+                                       "device sort in their time"
+                                     : "") +
                    (run.embree_version.empty()
                         ? std::string(".\n")
                         : "; xE: ratio to Embree " + run.embree_version +
@@ -194,6 +199,7 @@ std::string bench_markdown(const BenchRun& run) {
           if (!first) first = c;
           Spread rate = rate_of(c->ray_count, spread_of(c->kernel_ms));
           row += format(" %.2f (%.2f - %.2f)", rate.median, rate.min, rate.max);
+          if (c->sorted) row += " sorted";
           if (const BenchBaseline* b = baseline_for(run, *c)) {
             Spread embree = embree_rate(*c, *b);
             if (embree.median > 0.0) row += format(" x%.2fE", rate.median / embree.median);

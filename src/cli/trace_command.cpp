@@ -28,6 +28,7 @@ struct TraceOptions {
   std::string precision = "robust";
   bool any = false;
   bool coherent = false;
+  bool scattered = false;
   int repeat = 1;  // timed launches; above 1, after one warm-up launch
 };
 
@@ -61,11 +62,7 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
       cl::Event done = accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence);
       done.wait();
       double ms = ms_since(start);
-      if (result.profiled) {
-        cl_ulong begin = done.getProfilingInfo<CL_PROFILING_COMMAND_START>();
-        cl_ulong end = done.getProfilingInfo<CL_PROFILING_COMMAND_END>();
-        ms = static_cast<double>(end - begin) * 1e-6;
-      }
+      if (result.profiled) ms = accel.last_call_ms(done);
       result.trace_ms.push_back(ms);
     }
     std::sort(result.trace_ms.begin(), result.trace_ms.end());
@@ -118,12 +115,15 @@ void run_trace(const TraceOptions& options) {
       accel->name().c_str(), std::string(precision_name(config.precision)).c_str(), stats.build_ms, setup_ms, static_cast<double>(stats.device_bytes) / 1048576.0);
 
   Query query = options.any ? Query::any : Query::closest;
-  Coherence coherence = options.coherent ? Coherence::coherent : Coherence::incoherent;
+  Coherence coherence = options.coherent    ? Coherence::coherent
+                        : options.scattered ? Coherence::scattered
+                                            : Coherence::incoherent;
   std::vector<Hit> hits(rays.size());
   TraceResult traced = trace_on_device(*accel, rays, hits, query, coherence, options.rays, options.repeat);
   const char* kind = options.any ? "any hit (occlusion)" : "closest hit";
   std::size_t per_item = accel->rays_per_work_item(coherence);
   std::string traversal = per_item == 1 ? "one ray per work-item" : std::to_string(per_item) + "-ray packets";
+  if (accel->sorts(coherence)) traversal = "sorted on the device, then " + traversal;
   if (std::size_t run = accel->occluder_run(coherence); options.any && run > 1)
     traversal += " in runs of " + std::to_string(run) + ", each tested first against the previous one's occluder";
   if (rays.empty()) {
@@ -179,6 +179,12 @@ void add_trace_command(CLI::App& app) {
                 "then trace 8 rays per work-item: faster for such rays, slower for scattered ones; the closest t is "
                 "the same (on an exact tie another primitive may be reported). Other devices trace one ray per "
                 "work-item either way (faster there)");
+  cmd->add_flag("--scattered", options->scattered,
+                "the rays are many unrelated bounces (diffuse or glossy rays from hits in pixel order): on a CPU "
+                "device, structures with a single-ray kernel sort them on the device by origin cell and direction "
+                "octant first, and the time includes the sort (README, Ray queues and packets). The hits are the "
+                "same")
+      ->excludes("--coherent");
   cmd->callback([options] { run_trace(*options); });
 }
 

@@ -64,9 +64,13 @@ void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, cons
                                                         {Coherence::incoherent, Query::any}};
       if (accel && accel->rays_per_work_item(Coherence::coherent) != accel->rays_per_work_item(Coherence::incoherent))
         calls.insert(calls.end(), {{Coherence::coherent, Query::closest}, {Coherence::coherent, Query::any}});
+      // The sort is the same at every level (RTCL_TRACE_ORDER changes the
+      // ray's read and the hit's write only): checked at the default level.
+      if (accel && accel->sorts(Coherence::scattered) && level == Precision::robust)
+        calls.insert(calls.end(), {{Coherence::scattered, Query::closest}, {Coherence::scattered, Query::any}});
       for (auto [coherence, query] : calls) {
-        std::string what = name + " " + std::string(precision_name(level)) +
-                           (coherence == Coherence::coherent ? " coherent " : " ") + query_name(query) + " on " +
+        const char* order = coherence == Coherence::coherent ? " coherent " : coherence == Coherence::scattered ? " scattered " : " ";
+        std::string what = name + " " + std::string(precision_name(level)) + order + query_name(query) + " on " +
                            geometry.source;
         SCOPED_TRACE(what);
         const std::vector<Hit>& expected = brute_hits[query == Query::closest ? 0 : 1];

@@ -24,12 +24,19 @@ Accel::Accel(const Device& device, std::string name, TraceKernels incoherent, st
       defines_(with_precision(device.info(), std::move(defines), config.precision)),
       incoherent_{std::move(incoherent), {}, {}} {
   if (coherent) coherent_ = KernelSet{std::move(*coherent), {}, {}};
+  const TraceKernels& single = incoherent_.spec;
+  if (single.rays_per_work_item == 1 && single.sortable && device.info().type == "cpu")
+    scattered_ = KernelSet{single, {}, {}, true};
   kernel_for(Coherence::incoherent, Query::closest);
 }
 
 Accel::KernelSet& Accel::set_for(Coherence coherence) const {
-  return coherence == Coherence::coherent && coherent_ ? *coherent_ : incoherent_;
+  if (coherence == Coherence::coherent && coherent_) return *coherent_;
+  if (coherence == Coherence::scattered && scattered_) return *scattered_;
+  return incoherent_;
 }
+
+bool Accel::sorts(Coherence coherence) const { return set_for(coherence).ordered; }
 
 Accel::QueryKernel& Accel::kernel_for(Coherence coherence, Query query) const {
   KernelSet& set = set_for(coherence);
@@ -37,6 +44,7 @@ Accel::QueryKernel& Accel::kernel_for(Coherence coherence, Query query) const {
   if (slot) return *slot;
   std::vector<std::string> defines = defines_;
   defines.push_back(query == Query::closest ? "RTCL_QUERY_CLOSEST" : "RTCL_QUERY_ANY");
+  if (set.ordered) defines.push_back("RTCL_TRACE_ORDER");
   cl::Program program = device_.program(set.spec.file, defines);
   std::string stem = set.spec.file.substr(set.spec.file.rfind('/') + 1);
   stem = stem.substr(0, stem.rfind('.'));
@@ -61,8 +69,9 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
       throw Error(name_ + " trace: hit buffer holds " + std::to_string(hit_bytes / sizeof(Hit)) + " hits, " +
                   std::to_string(ray_count) + " requested");
     QueryKernel& slot = kernel_for(coherence, query);
+    const KernelSet& set = set_for(coherence);
     if (!slot.args_set) {
-      set_structure_args(slot.kernel, 3);
+      set_structure_args(slot.kernel, set.ordered ? 4 : 3);
       slot.args_set = true;
     }
     cl::Kernel& kernel = slot.kernel;
@@ -73,21 +82,41 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     cl::Event done;
     if (ray_count == 0) {
       device_.queue().enqueueMarkerWithWaitList(&wait, &done);
+      first_event_ = done;
       return done;
+    }
+    std::vector<cl::Event> before = wait;
+    if (set.ordered) {
+      if (!sort_) sort_ = std::make_unique<RaySort>(device_, stats_.bounds);
+      std::vector<cl::Event> passes = sort_->enqueue(rays, ray_count, wait);
+      kernel.setArg(0, sort_->sorted_rays());
+      kernel.setArg(3, sort_->order());
+      before = {passes.back()};
+      first_event_ = passes.front();
     }
     // A fixed work-group size (global rounded up; the kernels check ray_count):
     // PoCL generates code per local size, and left to choose (NULL) it picks
     // one per global size, so each new ray count would cost a code generation.
     const std::size_t group = 64;
     bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device()) >= group;
-    const TraceKernels& spec = set_for(coherence).spec;
+    const TraceKernels& spec = set.spec;
     std::size_t per_item = spec.rays_per_work_item * (query == Query::any ? spec.occluder_run : 1);
     std::size_t items = (ray_count + per_item - 1) / per_item;
     std::size_t global = fixed ? (items + group - 1) / group * group : items;
     device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
                                          fixed ? cl::NDRange(group) : cl::NullRange,
-                                         wait.empty() ? nullptr : &wait, &done);
+                                         before.empty() ? nullptr : &before, &done);
+    if (!set.ordered) first_event_ = done;
     return done;
+  });
+}
+
+double Accel::last_call_ms(const cl::Event& done) const {
+  return with_cl_errors([&] {
+    done.wait();
+    return static_cast<double>(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                               first_event_.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+           1e-6;
   });
 }
 

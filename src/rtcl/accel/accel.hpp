@@ -13,6 +13,7 @@
 
 #include "rtcl/accel/options.hpp"
 #include "rtcl/accel/precision.hpp"
+#include "rtcl/accel/ray_sort.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/scene/geometry.hpp"
 
@@ -28,8 +29,10 @@ enum class Query {
 // is the same either way (on an exact tie of t, or for Query::any, which of
 // the hit primitives is reported may differ).
 enum class Coherence {
-  // No promise: diffuse and glossy bounces, reflections and refractions,
-  // rays in arbitrary order. Each work-item traces one ray.
+  // No promise: reflections and refractions, rays in arbitrary order, and
+  // rays whose order is good for single rays (camera rays in pixel order,
+  // shadow rays towards one light). Each work-item traces one ray, in the
+  // caller's order.
   incoherent,
   // Each consecutive group of 8 rays (0-7, 8-15, ...) is alike: nearby
   // origins, similar directions. E.g. camera rays in 8x8 screen-tile order
@@ -37,6 +40,14 @@ enum class Coherence {
   // or Morton order (render/ray_order.hpp). A structure with a packet kernel
   // traces each group in one work-item; the others treat it as incoherent.
   coherent,
+  // Many rays whose neighbours are unrelated: diffuse and glossy bounces
+  // from hits in pixel order. On CPU devices a structure with a single-ray
+  // kernel first sorts them on the device by their origin's cell and
+  // direction's octant (RaySort, rtcl/accel/ray_sort.hpp), traces them in
+  // that order and writes each hit at its ray's index: two more passes
+  // over the rays, which pay where a ray visits many nodes (README
+  // "Scattered rays sorted on the device"). Elsewhere as incoherent.
+  scattered,
 };
 
 // How a structure is built and which kernels it compiles.
@@ -55,6 +66,7 @@ struct AccelStats {
   std::size_t zero_area_skipped = 0;
   std::size_t node_count = 0;        // inner nodes (0 for brute force)
   std::size_t leaf_count = 0;        // primitive blocks
+  Aabb bounds;                       // the geometry's box (RaySort's grid of origins)
 };
 
 class Accel {
@@ -76,6 +88,9 @@ class Accel {
   // against the leaf that blocked the previous one; 1: no such test.
   std::size_t occluder_run(Coherence coherence) const;
 
+  // Whether calls of this coherence sort the rays first (Coherence::scattered).
+  bool sorts(Coherence coherence) const;
+
   // The -D options (and -cl-... flags) its trace programs are built with,
   // before the query's RTCL_QUERY_CLOSEST / RTCL_QUERY_ANY.
   const std::vector<std::string>& build_options() const { return defines_; }
@@ -91,6 +106,13 @@ class Accel {
   // for applications on the OpenCL C API.
   cl::Event trace(Query query, cl_mem rays, cl_mem hits, std::size_t ray_count,
                   const std::vector<cl::Event>& wait = {}, Coherence coherence = Coherence::incoherent) const;
+  // The first command the latest trace call enqueued: the sort's first pass
+  // for a call that sorts, else the kernel (trace's event).
+  const cl::Event& first_event() const { return first_event_; }
+  // The latest call's time on the device in ms, from first_event()'s start
+  // to the end of `done`, the event it returned (waits for it; needs a
+  // profiling queue, Device::profiling()).
+  double last_call_ms(const cl::Event& done) const;
 
  protected:
   // The trace kernels of one kernel file: "accel/bvh.cl" defines
@@ -108,6 +130,10 @@ class Accel {
     std::string file;
     std::size_t rays_per_work_item = 1;
     std::size_t occluder_run = 1;
+    // Its single-ray kernels come from RTCL_TRACE_KERNELS* (kernels/shared/trace.h),
+    // which read the rays through an order when built with RTCL_TRACE_ORDER
+    // (Coherence::scattered).
+    bool sortable = true;
   };
   // `incoherent` serves Coherence::incoherent calls, and coherent ones too
   // when `coherent` is absent. Both are built with `defines` plus the
@@ -130,10 +156,12 @@ class Accel {
     cl::Kernel kernel;
     bool args_set = false;  // set_structure_args done (at its first trace: the constructor runs before the structure exists)
   };
-  // One kernel per query of one TraceKernels, each built at its first use.
+  // One kernel per query of one TraceKernels, each built at its first use;
+  // `ordered`: built with RTCL_TRACE_ORDER, its argument 3 the sort's order.
   struct KernelSet {
     TraceKernels spec;
     std::optional<QueryKernel> closest, any;
+    bool ordered = false;
   };
   KernelSet& set_for(Coherence coherence) const;
   QueryKernel& kernel_for(Coherence coherence, Query query) const;
@@ -144,7 +172,9 @@ class Accel {
   Precision precision_;
   std::vector<std::string> defines_;  // structure's, then the precision level's
   mutable KernelSet incoherent_;
-  mutable std::optional<KernelSet> coherent_;
+  mutable std::optional<KernelSet> coherent_, scattered_;
+  mutable std::unique_ptr<RaySort> sort_;  // at the first call that sorts
+  mutable cl::Event first_event_;
 };
 
 // Names make_accel accepts, in the order benchmarks list them.

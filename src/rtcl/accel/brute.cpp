@@ -48,6 +48,7 @@ std::unique_ptr<Accel> make_brute(const Device& device, const Geometry& geometry
   stats.device_bytes = blocks.bytes();
   stats.primitive_count = ids.size();
   stats.zero_area_skipped = report.zero_area_triangles;
+  stats.bounds = geometry.bounds();
   stats.leaf_count = blocks.triangles.size() + blocks.spheres.size();
   return std::make_unique<BruteAccel>(device, geometry, std::move(blocks), stats, config);
 }

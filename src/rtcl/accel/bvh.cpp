@@ -169,6 +169,7 @@ AccelStats bvh_stats(const Geometry& geometry, const GeometryReport& report, con
   stats.device_bytes = bvh.nodes.size() * sizeof(Bvh8Node) + bvh.blocks.bytes();
   stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
   stats.zero_area_skipped = report.zero_area_triangles;
+  stats.bounds = geometry.bounds();
   stats.node_count = bvh.nodes.size();
   stats.leaf_count = bvh.blocks.triangles.size() + bvh.blocks.spheres.size();
   return stats;

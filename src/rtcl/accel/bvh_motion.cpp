@@ -190,7 +190,7 @@ MotionBvh::MotionBvh(const Device& device, const Geometry& open, const Geometry&
     : MotionBvh(device, build(open, close, bounds), bounds, config) {}
 
 MotionBvh::MotionBvh(const Device& device, std::unique_ptr<Data> d, MotionBounds bounds, const AccelConfig& config)
-    : Accel(device, "bvh-motion", TraceKernels{"accel/bvh_motion.cl"}, std::nullopt, d->defines, d->stats, config),
+    : Accel(device, "bvh-motion", TraceKernels{"accel/bvh_motion.cl", 1, 1, false}, std::nullopt, d->defines, d->stats, config),
       bounds_(bounds) {
   const bool lerp = bounds == MotionBounds::interpolated;
   nodes_ = upload_nodes(device, lerp ? d->nodes_open : d->bvh.nodes, "motion BVH nodes");

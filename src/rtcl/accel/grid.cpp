@@ -442,6 +442,7 @@ std::unique_ptr<Accel> make_grid(const Device& device, const Geometry& geometry,
   stats.device_bytes = grid.bytes();
   stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
   stats.zero_area_skipped = report.zero_area_triangles;
+  stats.bounds = geometry.bounds();
   stats.node_count = grid.cell_count();
   stats.leaf_count = grid.blocks.triangles.size() + grid.blocks.spheres.size();
   return std::make_unique<GridAccel>(device, geometry, grid, config.occluder_run, stats, accel_config);

@@ -318,6 +318,7 @@ std::unique_ptr<Accel> build_kd_accel(const Device& device, const Geometry& geom
   stats.device_bytes = tree.bytes();
   stats.primitive_count = geometry.primitive_count() - report.zero_area_triangles;
   stats.zero_area_skipped = report.zero_area_triangles;
+  stats.bounds = geometry.bounds();
   stats.node_count = tree.nodes.size() - tree.leaf_count;
   stats.leaf_count = tree.leaf_count;
   return make_kd_accel(device, geometry, name, tree, stats, config, traversal, occluder_run);

@@ -172,6 +172,7 @@ auto timed_octree_build(const Device& device, const Geometry& geometry, Config c
   stats->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   stats->primitive_count = geometry.primitive_count() - report.zero_area_triangles;
   stats->zero_area_skipped = report.zero_area_triangles;
+  stats->bounds = geometry.bounds();
   return tree;
 }
 
