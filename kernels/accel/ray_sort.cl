@@ -1,9 +1,10 @@
 /* Rays sorted on the device before a Coherence::scattered trace
- * (src/rtcl/accel/ray_sort.hpp): a stable counting sort of the ray records
+ * (src/rtcl/accel/ray_sort.hpp): a stable counting sort of the ray indices
  * by a short key, so that rays traced one after another start near each
  * other and go the same way, and the nodes they visit stay in cache. The
- * trace then reads sorted[k] and writes its hit at hits[order[k]]
- * (RTCL_TRACE_ORDER, kernels/shared/trace.h).
+ * trace then reads rays[order[k]] and writes its hit at hits[order[k]]
+ * (RTCL_TRACE_ORDER, kernels/shared/trace.h); the ray records stay where
+ * they are.
  *
  * Key (RTCL_SORT_BUCKETS = 2^(3 * RTCL_SORT_ORIGIN_BITS + 3) values): the
  * Morton code of the origin on a grid of 2^RTCL_SORT_ORIGIN_BITS cells per
@@ -14,11 +15,12 @@
  *
  * Three passes over C chunks of `chunk` consecutive rays (one work-item a
  * chunk, C = the global size of ray_sort_count and ray_sort_scatter):
- *   ray_sort_count   counts[c * BUCKETS + b] = rays of chunk c with key b
+ *   ray_sort_count   keys[i] = ray i's key; counts[c * BUCKETS + b] = rays
+ *                    of chunk c with key b
  *   ray_sort_offsets per bucket, the exclusive prefix sum over the chunks
  *                    and the bucket's total (one work-item a bucket)
- *   ray_sort_scatter each chunk writes its rays, in their order, from its
- *                    start in each bucket on: sorted[k] = rays[order[k]]
+ *   ray_sort_scatter each chunk writes its ray indices, in their order, from
+ *                    its start in each bucket on: order[k] = i
  * Equal keys keep their input order, so the order is a function of the rays
  * alone. */
 #include "shared/layouts.h"
@@ -26,7 +28,7 @@
 #ifndef RTCL_SORT_ORIGIN_BITS
 #define RTCL_SORT_ORIGIN_BITS 3
 #endif
-#define RTCL_SORT_BUCKETS (1u << (3 * RTCL_SORT_ORIGIN_BITS + 3))
+#define RTCL_SORT_BUCKETS (1u << (3 * RTCL_SORT_ORIGIN_BITS + 3)) /* at most 2^15: keys are ushort */
 
 /* The bits of x (< 32) spread three apart: bit i to bit 3i. */
 inline __attribute__((always_inline)) uint ray_sort_spread3(uint x) {
@@ -47,12 +49,16 @@ inline __attribute__((always_inline)) uint ray_sort_key(global const Ray* r, flo
 }
 
 kernel void ray_sort_count(global const Ray* rays, uint ray_count, uint chunk, float4 lo, float4 scale,
-                           global uint* counts) {
+                           global uint* counts, global ushort* keys) {
   uint c = get_global_id(0);
   uint row[RTCL_SORT_BUCKETS];
   for (uint b = 0; b < RTCL_SORT_BUCKETS; ++b) row[b] = 0;
   uint begin = c * chunk, end = min(begin + chunk, ray_count);
-  for (uint i = begin; i < end; ++i) ++row[ray_sort_key(rays + i, lo, scale)];
+  for (uint i = begin; i < end; ++i) {
+    uint key = ray_sort_key(rays + i, lo, scale);
+    keys[i] = (ushort)key;
+    ++row[key];
+  }
   global uint* out = counts + (size_t)c * RTCL_SORT_BUCKETS;
   for (uint b = 0; b < RTCL_SORT_BUCKETS; ++b) out[b] = row[b];
 }
@@ -73,9 +79,8 @@ kernel void ray_sort_offsets(global uint* counts, uint chunks, global uint* tota
 
 /* Each chunk's start in bucket b: the rays of the buckets before b, plus its
  * offset within bucket b. */
-kernel void ray_sort_scatter(global const Ray* rays, uint ray_count, uint chunk, float4 lo, float4 scale,
-                             global const uint* offsets, global const uint* totals, global Ray* sorted,
-                             global uint* order) {
+kernel void ray_sort_scatter(global const ushort* keys, uint ray_count, uint chunk,
+                             global const uint* offsets, global const uint* totals, global uint* order) {
   uint c = get_global_id(0);
   uint row[RTCL_SORT_BUCKETS];
   global const uint* in = offsets + (size_t)c * RTCL_SORT_BUCKETS;
@@ -85,9 +90,5 @@ kernel void ray_sort_scatter(global const Ray* rays, uint ray_count, uint chunk,
     before += totals[b];
   }
   uint begin = c * chunk, end = min(begin + chunk, ray_count);
-  for (uint i = begin; i < end; ++i) {
-    uint k = row[ray_sort_key(rays + i, lo, scale)]++;
-    sorted[k] = rays[i];
-    order[k] = i;
-  }
+  for (uint i = begin; i < end; ++i) order[row[keys[i]]++] = i;
 }

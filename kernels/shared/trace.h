@@ -33,14 +33,29 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
 #endif
 
 /* With RTCL_TRACE_ORDER (a Coherence::scattered call, kernels/accel/ray_sort.cl)
- * the kernel takes `global const uint* order` after ray_count: rays[k] is
- * the caller's ray order[k], and its hit goes to hits[order[k]]. */
+ * the kernel takes `global const uint* order` after ray_count: the k-th ray
+ * traced is rays[order[k]], and its hit goes to hits[order[k]]. The ray
+ * RTCL_TRACE_PREFETCH places ahead in the order is prefetched (the rays
+ * are read out of memory order; without it sibenik's diffuse bounces traced
+ * at 1.08x the unsorted speed instead of 1.19x, one run). */
 #ifdef RTCL_TRACE_ORDER
 #define RTCL_TRACE_ORDER_PARAM global const uint *order,
 #define RTCL_TRACE_HIT_INDEX(k) order[k]
+#define RTCL_TRACE_PREFETCH 8
+#define RTCL_TRACE_RAY_INDEX(k) rtcl_trace_ray_index(rays, order, k, ray_count)
+inline uint rtcl_trace_ray_index(global const Ray* rays, global const uint* order, uint k, uint ray_count) {
+  uint ahead = k + RTCL_TRACE_PREFETCH;
+#ifdef __clang__
+  if (ahead < ray_count) __builtin_prefetch(rays + order[ahead]);
+#else
+  if (ahead < ray_count) prefetch((global const float8*)(rays + order[ahead]), 1);
+#endif
+  return order[k];
+}
 #else
 #define RTCL_TRACE_ORDER_PARAM
 #define RTCL_TRACE_HIT_INDEX(k) (k)
+#define RTCL_TRACE_RAY_INDEX(k) (k)
 #endif
 
 /* Defines the kernel from an inline function
@@ -53,7 +68,7 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
     if (i >= ray_count) return;                                                                     \
     TraceRay s;                                                                                     \
     HitState h;                                                                                     \
-    if (begin_trace(rays, i, &s, &h)) NAME##_traverse(&s, &h, ARGS);                                \
+    if (begin_trace(rays, RTCL_TRACE_RAY_INDEX(i), &s, &h)) NAME##_traverse(&s, &h, ARGS);          \
     end_trace(hits, RTCL_TRACE_HIT_INDEX(i), &h);                                                   \
   }
 
@@ -82,7 +97,8 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
     for (uint i = (uint)first; i < end; ++i) {                                                        \
       TraceRay s;                                                                                     \
       HitState h;                                                                                     \
-      if (begin_trace(rays, i, &s, &h) && (occluder < 0 || !NAME##_leaf(occluder, &s, &h, ARGS)))     \
+      if (begin_trace(rays, RTCL_TRACE_RAY_INDEX(i), &s, &h) &&                                      \
+          (occluder < 0 || !NAME##_leaf(occluder, &s, &h, ARGS)))                                     \
         occluder = NAME##_traverse(&s, &h, ARGS);                                                     \
       end_trace(hits, RTCL_TRACE_HIT_INDEX(i), &h);                                                   \
     }                                                                                                 \

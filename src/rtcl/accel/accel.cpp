@@ -89,7 +89,6 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     if (set.ordered) {
       if (!sort_) sort_ = std::make_unique<RaySort>(device_, stats_.bounds);
       std::vector<cl::Event> passes = sort_->enqueue(rays, ray_count, wait);
-      kernel.setArg(0, sort_->sorted_rays());
       kernel.setArg(3, sort_->order());
       before = {passes.back()};
       first_event_ = passes.front();

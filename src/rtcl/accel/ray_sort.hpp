@@ -1,8 +1,8 @@
 // The device sort of a Coherence::scattered trace call (kernels/accel/ray_sort.cl):
 // rays reordered by the Morton code of their origin's cell on a coarse grid
 // over the scene's box and their direction's octant, so that rays traced one
-// after another visit the same nodes. Accel::trace then traces sorted_rays()
-// and writes each hit at its caller's index (order()).
+// after another visit the same nodes. Accel::trace then traces ray order()[k]
+// k-th and writes its hit at that index; the ray records are not moved.
 #pragma once
 
 #include <cstddef>
@@ -17,18 +17,16 @@ class RaySort {
  public:
   // Origins binned on 2^origin_bits cells per axis over `bounds` (an empty
   // box: the octant alone); 0 .. 4, else Error. 3 by measurement (README
-  // "Scattered rays sorted on the device"): against 2 the trace 2-4%
-  // faster and the sort up to 1.5 ms slower per million rays; 4 (32,768
-  // buckets) cost 14-19 ms per call.
+  // "Scattered rays sorted on the device").
   RaySort(const Device& device, const Aabb& bounds, int origin_bits = 3);
 
   // Enqueues the sort of rays[0 .. ray_count), ray_count >= 1 (else Error;
   // Accel::trace sorts no empty call), after `wait`; returns the
   // events of its passes in order (the first starts the call's device
-  // time). Then sorted_rays()[k] = rays[order()[k]].
+  // time). Then order() holds the ray indices sorted by key, equal keys in
+  // their input order.
   std::vector<cl::Event> enqueue(const cl::Buffer& rays, std::size_t ray_count, const std::vector<cl::Event>& wait);
 
-  const cl::Buffer& sorted_rays() const { return sorted_; }
   const cl::Buffer& order() const { return order_; }
 
  private:
@@ -38,7 +36,7 @@ class RaySort {
   cl_float4 lo_{}, scale_{};
   std::size_t buckets_;
   cl::Kernel count_, offsets_, scatter_;
-  cl::Buffer counts_, totals_, sorted_, order_;
+  cl::Buffer counts_, totals_, keys_, order_;
   std::size_t ray_capacity_ = 0, chunk_capacity_ = 0;
 };
 
