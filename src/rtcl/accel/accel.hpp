@@ -44,9 +44,10 @@ enum class Coherence {
   // from hits in pixel order. On CPU devices a structure with a single-ray
   // kernel first sorts them on the device by their origin's cell and
   // direction's octant (RaySort, rtcl/accel/ray_sort.hpp), traces them in
-  // that order and writes each hit at its ray's index: two more passes
-  // over the rays, which pay where a ray visits many nodes (README
-  // "Scattered rays sorted on the device"). Elsewhere as incoherent.
+  // that order and writes each hit at its ray's index: one more pass over
+  // the rays and two over their keys, which pay where a ray visits many
+  // nodes (README "Scattered rays sorted on the device"). Elsewhere as
+  // incoherent.
   scattered,
 };
 
