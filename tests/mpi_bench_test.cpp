@@ -1,7 +1,8 @@
 // `mpirun -np N rtcl bench` on localhost against the single-process
 // `rtcl bench` of the same matrix: the merged bench.json holds exactly the
-// single run's cells (scene, structure, ray set; same ray counts), each
-// agreeing with brute force, each on a device entry that names its rank.
+// single run's cells (scene, structure, ray set; the same ray counts,
+// packets, occluder runs and sorting), each agreeing with brute force, each
+// on a device entry that names its rank.
 // Built only with MPI (RTCL_HAVE_MPI).
 #include <gtest/gtest.h>
 
@@ -38,8 +39,8 @@ std::map<Key, nlohmann::json> cells_of(const nlohmann::json& json) {
 TEST(MpiBench, TheMatrixSplitOverRanksMergesIntoTheSingleRunsCells) {
   TempDir dir;
   const std::vector<std::string> args = {"bench", "--size", "24", "--scene", "tetra:levels=2,sphereflake:levels=1",
-                                         "--accel", "bvh,grid,kdtree", "--rays", "primary,shadow", "--repeat", "1",
-                                         "--check-rays", "32"};
+                                         "--accel", "bvh,grid,kdtree", "--rays", "primary,shadow,diffuse", "--repeat",
+                                         "1", "--check-rays", "32", "--sort-diffuse"};
   std::vector<std::string> single = args, split = args;
   single.insert(single.end(), {"--device", "0", "-o", dir.file("single")});
   split.insert(split.end(), {"-o", dir.file("split")});
@@ -55,7 +56,8 @@ TEST(MpiBench, TheMatrixSplitOverRanksMergesIntoTheSingleRunsCells) {
   for (const auto& [key, cell] : reference) {
     ASSERT_TRUE(merged.count(key)) << std::get<0>(key) << " " << std::get<1>(key) << " " << std::get<2>(key);
     const nlohmann::json& m = merged[key];
-    EXPECT_EQ(m["ray_count"], cell["ray_count"]) << m.dump();
+    for (const char* field : {"ray_count", "packets", "occluder_run", "sorted"})
+      EXPECT_EQ(m[field], cell[field]) << field << ": " << m.dump();
     EXPECT_TRUE(m["check"]["ok"].get<bool>()) << m.dump();
     std::size_t device = m["device"];
     ASSERT_LT(device, b["devices"].size());

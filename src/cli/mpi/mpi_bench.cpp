@@ -23,7 +23,7 @@ namespace {
 
 nlohmann::json cell_json(const BenchCell& c) {
   return {{"scene", c.scene},       {"accel", c.accel},         {"rays", c.rays},
-          {"precision", c.precision}, {"packets", c.packets},
+          {"precision", c.precision}, {"packets", c.packets}, {"occluder_run", c.occluder_run}, {"sorted", c.sorted},
           {"query", c.query},       {"ray_count", c.ray_count}, {"build_ms", c.build_ms},
           {"setup_ms", c.setup_ms}, {"first_launch_ms", c.first_launch_ms},
           {"device_bytes", c.device_bytes}, {"primitives", c.primitives},
@@ -39,6 +39,8 @@ BenchCell cell_of(const nlohmann::json& j, std::size_t device) {
   c.rays = j["rays"];
   c.precision = j["precision"];
   c.packets = j["packets"];
+  c.occluder_run = j["occluder_run"];
+  c.sorted = j["sorted"];
   c.query = j["query"];
   c.ray_count = j["ray_count"];
   c.build_ms = j["build_ms"];
