@@ -40,13 +40,6 @@ namespace {
 using namespace rtcl;
 using namespace rtcl::bench;
 
-double span_ms(const cl::Event& first, const cl::Event& last) {
-  last.wait();
-  return static_cast<double>(last.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
-                             first.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
-         1e-6;
-}
-
 int run(int argc, char** argv) {
   if (argc < 3 || argc > 4) {
     std::fprintf(stderr, "usage: rtcl_ray_sort_ab SCENES ROUNDS [ACCEL]  (e.g. bunny,sponza 7 bvh)\n");
@@ -117,9 +110,9 @@ int run(int argc, char** argv) {
             host_ms.push_back(kernel_ms(accel->trace(set.query, host_buffer, hit_buffer, n)));
           } else {
             cl::Event done = accel->trace(set.query, ray_buffer, hit_buffer, n, {}, Coherence::scattered);
-            span.push_back(span_ms(accel->first_event(), done));
+            span.push_back(accel->last_call_ms(done));
             trace_ms.push_back(kernel_ms(done));
-            sort_ms.push_back(span_ms(accel->first_event(), done) - trace_ms.back());
+            sort_ms.push_back(span.back() - trace_ms.back());
           }
         }
       std::printf("%-8s %-8s %8zu rays | incoherent %7.2f / %7.2f ms | scattered %7.2f / %7.2f ms (sort %5.2f, "

@@ -1,14 +1,19 @@
 #include "rtcl/accel/ray_sort.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <string>
 
 #include "rtcl/error.hpp"
-#include "rtcl/layouts.hpp"
 
 namespace rtcl {
 
 namespace {
+
+int checked_origin_bits(int bits) {
+  if (bits < 0 || bits > 4) throw Error("ray sort: origin_bits " + std::to_string(bits) + " is not in 0 .. 4");
+  return bits;
+}
 
 // Rays per chunk at least, and chunks per compute unit at most: enough
 // chunks to share the passes among the cores, few enough that the prefix
@@ -20,8 +25,7 @@ constexpr std::size_t kChunksPerUnit = 4;
 }  // namespace
 
 RaySort::RaySort(const Device& device, const Aabb& bounds, int origin_bits)
-    : device_(device), buckets_(std::size_t{1} << (3 * origin_bits + 3)) {
-  if (origin_bits < 0 || origin_bits > 4) throw Error("ray sort: origin_bits " + std::to_string(origin_bits) + " is not in 0 .. 4");
+    : device_(device), buckets_(std::size_t{1} << (3 * checked_origin_bits(origin_bits) + 3)) {
   if (!bounds.empty()) {
     const float cells = static_cast<float>(1u << origin_bits);
     const glm::vec3 extent = bounds.upper - bounds.lower;
