@@ -34,8 +34,11 @@
 // Embree), AB_SETS (the ray sets to time, e.g. "primary,shadow"; default
 // all three), AB_MORTON_ORDER (set: every timed set traced, by every
 // version and Embree, in the host's Morton order of render/ray_order.hpp
-// instead of the camera's row order), RTCL_BENCH_RES, RTCL_SCENES_DIR,
-// RTCL_DEVICE.
+// instead of the camera's row order), AB_REPEAT_RAYS (N in 1 .. 1024: every
+// timed set's rays replaced by every N-th ray, each traced N times in a row,
+// by every version and Embree: the same count of rays, whose caches and
+// branch history then see each path N times), RTCL_BENCH_RES,
+// RTCL_SCENES_DIR, RTCL_DEVICE.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -99,6 +102,10 @@ int run(int argc, char** argv) {
     if (name != "primary" && name != "shadow" && name != "diffuse")
       throw Error("AB_SETS: unknown ray set '" + name + "' (known: primary, shadow, diffuse)");
   const bool morton = std::getenv("AB_MORTON_ORDER") != nullptr;
+  const char* repeat_env = std::getenv("AB_REPEAT_RAYS");
+  const int repeat = repeat_env && *repeat_env ? std::atoi(repeat_env) : 1;
+  if (repeat < 1 || repeat > 1024)
+    throw Error(std::string("AB_REPEAT_RAYS must be a number in 1 .. 1024, not '") + repeat_env + "'");
 #ifdef RTCL_HAVE_EMBREE
   const bool use_embree = std::getenv("AB_NO_EMBREE") == nullptr;
 #endif
@@ -154,9 +161,9 @@ int run(int argc, char** argv) {
 #endif
     for (const Set& set : sets) {
       if (std::find(timed_sets.begin(), timed_sets.end(), set.name) == timed_sets.end()) continue;
-      std::vector<Ray> morton_rays;
-      if (morton) morton_rays = gather<Ray>(*set.rays, morton_order(*set.rays, geometry.bounds()));
-      const std::vector<Ray>& rays = morton ? morton_rays : *set.rays;
+      std::vector<Ray> rays = *set.rays;
+      if (morton) rays = gather<Ray>(rays, morton_order(rays, geometry.bounds()));
+      for (std::size_t i = 0; i < rays.size(); ++i) rays[i] = rays[i - i % static_cast<std::size_t>(repeat)];
       std::vector<Hit> first, other;
       launch(0, set.query, rays, &first);
       for (std::size_t v = 1; v < versions.size(); ++v) {
