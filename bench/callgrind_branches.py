@@ -43,8 +43,13 @@ def branch_costs(path, suffix, query):
     in_call = False
     last = [0, 0]
     costs = collections.defaultdict(lambda: [0, 0])
-    for line in open(path):
-        line = line.rstrip("\n")
+    try:
+        lines = open(path).read().splitlines()
+    except OSError as e:
+        sys.exit(f"{path}: cannot read ({e.strerror})")
+    if not any(l.startswith("positions:") and l.split()[1:2] == ["instr"] for l in lines):
+        sys.exit(f"{path}: positions are not instruction addresses (run callgrind with --dump-instr=yes)")
+    for line in lines:
         if line.startswith("events:"):
             events = line.split()[1:]
             continue
