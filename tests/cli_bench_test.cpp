@@ -50,6 +50,7 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
   ASSERT_EQ(json["devices"].size(), 1u);
   EXPECT_TRUE(json["devices"][0]["driver"].is_string());
   EXPECT_EQ(json["options"]["repeat"], 2);
+  EXPECT_EQ(json["options"]["diffuse_sort"], "measured");
   // Embree's packet API is measured where Embree traces 8-ray packets natively.
   bool embree_packets = false;
   if (json["embree"].is_object())
@@ -71,7 +72,10 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
     // occlusion in runs: every shadow cell on a CPU device, no other cell
     const bool runs = cell["rays"] == "shadow" && json["devices"][0]["type"] == "cpu";
     EXPECT_EQ(cell["occluder_run"].get<int>(), runs ? 16 : 1) << cell.dump();
-    EXPECT_FALSE(cell["sorted"].get<bool>()) << "sorted without --sort-diffuse: " << cell.dump();
+    // only scattered calls (the diffuse sets) of single-ray kernels may sort
+    const bool may_sort = cell["rays"] == "diffuse" && cell["accel"] != "bvh-packet";
+    EXPECT_GE(cell["sorted_runs"].get<int>(), 0) << cell.dump();
+    EXPECT_LE(cell["sorted_runs"].get<int>(), may_sort ? 2 : 0) << cell.dump();
     ASSERT_TRUE(cell.contains("embree"));
 #ifdef RTCL_TESTS_EXPECT_EMBREE
     // packets against packets: the packet kernel is compared with rtcIntersect8 / rtcOccluded8
@@ -115,28 +119,40 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
   EXPECT_NE(md.find("| tetra:levels=2 | grid |"), std::string::npos) << md;
 }
 
-// --sort-diffuse: the diffuse cells of structures whose scattered calls sort
-// (single-ray kernels on a CPU device) are sorted, agree with brute force
-// and say so; no other cell is.
-TEST(CliBench, SortDiffuseSortsOnlyTheDiffuseCellsThatCan) {
-  TempDir dir;
-  CliRun run = run_cli(dir,
-                       {"bench", "--size", "32", "--scene", "bunny", "--accel", "bvh,bvh-packet,grid", "--rays",
-                        "primary,diffuse", "--repeat", "1", "--check-rays", "64", "--device", "0", "--sort-diffuse",
-                        "-o", dir.file("out")},
-                       scenes_env());
-  ASSERT_EQ(run.status, 0) << run.err;
-  nlohmann::json json = nlohmann::json::parse(read_text(dir.file("out/bench.json")));
-  EXPECT_TRUE(json["options"]["sort_diffuse"].get<bool>());
-  const bool cpu = json["devices"][0]["type"] == "cpu";
-  ASSERT_EQ(json["cells"].size(), 6u);
-  for (const auto& cell : json["cells"]) {
-    const bool sorts = cpu && cell["rays"] == "diffuse" && cell["accel"] != "bvh-packet";
-    EXPECT_EQ(cell["sorted"].get<bool>(), sorts) << cell.dump();
-    EXPECT_TRUE(cell["check"]["ok"].get<bool>()) << cell.dump();
+// --diffuse-sort always: the diffuse cells of structures whose scattered
+// calls can sort (single-ray kernels on a CPU device) are sorted in every
+// launch, agree with brute force and say so; no other cell is. never: none
+// is. Anything else: one message naming the option.
+TEST(CliBench, DiffuseSortAlwaysSortsOnlyTheDiffuseCellsThatCan) {
+  for (const char* policy : {"always", "never"}) {
+    SCOPED_TRACE(policy);
+    TempDir dir;
+    CliRun run = run_cli(dir,
+                         {"bench", "--size", "32", "--scene", "bunny", "--accel", "bvh,bvh-packet,grid", "--rays",
+                          "primary,diffuse", "--repeat", "2", "--check-rays", "64", "--device", "0", "--diffuse-sort",
+                          policy, "-o", dir.file("out")},
+                         scenes_env());
+    ASSERT_EQ(run.status, 0) << run.err;
+    nlohmann::json json = nlohmann::json::parse(read_text(dir.file("out/bench.json")));
+    EXPECT_EQ(json["options"]["diffuse_sort"], policy);
+    const bool cpu = json["devices"][0]["type"] == "cpu";
+    ASSERT_EQ(json["cells"].size(), 6u);
+    for (const auto& cell : json["cells"]) {
+      const bool sorts = std::string(policy) == "always" && cpu && cell["rays"] == "diffuse" &&
+                         cell["accel"] != "bvh-packet";
+      EXPECT_EQ(cell["sorted"].get<bool>(), sorts) << cell.dump();
+      EXPECT_EQ(cell["sorted_runs"].get<int>(), sorts ? 2 : 0) << cell.dump();
+      EXPECT_TRUE(cell["check"]["ok"].get<bool>()) << cell.dump();
+    }
+    std::string md = read_text(dir.file("out/bench.md"));
+    if (cpu) EXPECT_EQ(md.find(" sorted ") != std::string::npos, std::string(policy) == "always") << md;
   }
-  std::string md = read_text(dir.file("out/bench.md"));
-  if (cpu) EXPECT_NE(md.find(" sorted "), std::string::npos) << md;
+  TempDir dir;
+  CliRun bad = run_cli(dir, {"bench", "--size", "32", "--diffuse-sort", "sometimes", "-o", dir.file("out")},
+                       scenes_env());
+  EXPECT_NE(bad.status, 0);
+  EXPECT_NE(bad.err.find("--diffuse-sort sometimes: unknown (known: measured, always, never)"), std::string::npos)
+      << bad.err;
 }
 
 // --precision sets every structure's level and --embree-robust Embree's

@@ -40,7 +40,7 @@ TEST(MpiBench, TheMatrixSplitOverRanksMergesIntoTheSingleRunsCells) {
   TempDir dir;
   const std::vector<std::string> args = {"bench", "--size", "24", "--scene", "tetra:levels=2,sphereflake:levels=1",
                                          "--accel", "bvh,grid,kdtree", "--rays", "primary,shadow,diffuse", "--repeat",
-                                         "1", "--check-rays", "32", "--sort-diffuse"};
+                                         "1", "--check-rays", "32", "--diffuse-sort", "always"};
   std::vector<std::string> single = args, split = args;
   single.insert(single.end(), {"--device", "0", "-o", dir.file("single")});
   split.insert(split.end(), {"-o", dir.file("split")});

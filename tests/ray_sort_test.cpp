@@ -117,7 +117,7 @@ TEST(RaySort, RejectsOriginBitsOutOfRange) {
 
 TEST(RaySort, ScatteredCallTimesTheSortAndTheTrace) {
   Geometry g = random_soup(2000, 1);
-  std::unique_ptr<Accel> accel = make_accel(test_device(), "bvh", g);
+  std::unique_ptr<Accel> accel = make_accel(test_device(), "bvh", g, {Precision::robust, {}, ScatteredSort::always});
   if (!accel->sorts(Coherence::scattered)) GTEST_SKIP() << "scattered calls sort on CPU devices only";
   std::vector<Ray> rays = awkward_rays(20'000, g.bounds());
   const Device& device = test_device();

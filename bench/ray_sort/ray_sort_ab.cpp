@@ -57,7 +57,8 @@ int run(int argc, char** argv) {
     const SceneSpec& spec = fixed_camera_scene(scene_name);
     Geometry geometry = spec_geometry(spec, scenes_dir);
     validate(geometry);
-    std::unique_ptr<Accel> accel = make_accel(device, accel_name, geometry);
+    std::unique_ptr<Accel> accel =
+        make_accel(device, accel_name, geometry, AccelConfig{Precision::robust, {}, ScatteredSort::always});
     if (!accel->sorts(Coherence::scattered))
       throw Error(accel_name + " on " + device.info().name + ": its scattered calls do not sort");
 

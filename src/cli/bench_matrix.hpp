@@ -14,6 +14,7 @@
 #include "bench_report.hpp"
 #include "bench_scenes.hpp"
 #include "rtcl/accel/precision.hpp"
+#include "rtcl/accel/sort_choice.hpp"
 #include "rtcl/cl/device.hpp"
 
 namespace rtcl::cli {
@@ -26,7 +27,9 @@ struct BenchOptions {
   std::string precision = "robust";  // every structure's level (AccelConfig::precision)
   bool no_embree = false;  // without Embree built in, there is no baseline either way
   bool embree_robust = false;  // Embree's scenes with RTC_SCENE_FLAG_ROBUST
-  bool sort_diffuse = false;   // diffuse rays traced as Coherence::scattered calls
+  // Diffuse rays are traced as Coherence::scattered calls; whether they
+  // sort (AccelConfig::scattered_sort): measured, always or never.
+  std::string diffuse_sort = "measured";
   unsigned embree_threads = std::max(1u, std::thread::hardware_concurrency());
 };
 
@@ -36,7 +39,7 @@ struct BenchMatrix {
   std::vector<BenchSceneSpec> scenes;
   std::vector<int> kinds;  // 0 primary, 1 shadow, 2 diffuse
   Precision precision = Precision::robust;
-  bool sort_diffuse = false;  // BenchOptions::sort_diffuse
+  ScatteredSort diffuse_sort = ScatteredSort::measured;  // BenchOptions::diffuse_sort
   std::string json_path, md_path;
 };
 

@@ -85,6 +85,7 @@ json cell_json(const BenchCell& c, const BenchBaseline* baseline) {
       {"packets", c.packets},
       {"occluder_run", c.occluder_run},
       {"sorted", c.sorted},
+      {"sorted_runs", c.sorted_runs},
       {"device_bytes", c.device_bytes},
       {"primitives", c.primitives},
       {"bytes_per_primitive",
@@ -135,7 +136,7 @@ std::string bench_json(const BenchRun& run) {
       {"options", {{"size", run.size}, {"repeat", run.repeat}, {"check_rays", run.check_rays},
                    {"accel", run.accels}, {"scene", run.scenes}, {"rays", run.ray_kinds},
                    {"precision", run.precision}, {"embree_flags", run.embree_flags},
-                   {"sort_diffuse", run.sort_diffuse},
+                   {"diffuse_sort", run.diffuse_sort},
                    {"pocl_cache_dir", run.pocl_cache_dir}}},
       {"devices", devices},
       {"scenes", scenes},
@@ -168,9 +169,12 @@ std::string bench_markdown(const BenchRun& run) {
                    " rays per primary set, median (min - max) Mrays/s of " + std::to_string(run.repeat) +
                    " kernel launches after a warm-up (OpenCL event times), precision " + run.precision +
                    "; build: host ms; B/prim: device bytes per primitive; check: rays agreeing with brute force" +
-                   (run.sort_diffuse ? "; diffuse rays traced as scattered calls: \"sorted\" cells include the "
-                                       "device sort in their time"
-                                     : "") +
+                   (run.diffuse_sort != "never"
+                        ? "; diffuse rays traced as scattered calls, sorted on the device " +
+                              std::string(run.diffuse_sort == "always" ? "always"
+                                                                       : "where the structure measured that faster") +
+                              ": \"sorted\" cells include the sort in their time (\"sorted k/n\": k of n launches)"
+                        : std::string()) +
                    (run.embree_version.empty()
                         ? std::string(".\n")
                         : "; xE: ratio to Embree " + run.embree_version +
@@ -199,7 +203,10 @@ std::string bench_markdown(const BenchRun& run) {
           if (!first) first = c;
           Spread rate = rate_of(c->ray_count, spread_of(c->kernel_ms));
           row += format(" %.2f (%.2f - %.2f)", rate.median, rate.min, rate.max);
-          if (c->sorted) row += " sorted";
+          if (c->sorted_runs > 0 && c->sorted_runs == static_cast<int>(c->kernel_ms.size()))
+            row += " sorted";
+          else if (c->sorted_runs > 0)
+            row += " sorted " + std::to_string(c->sorted_runs) + "/" + std::to_string(c->kernel_ms.size());
           if (const BenchBaseline* b = baseline_for(run, *c)) {
             Spread embree = embree_rate(*c, *b);
             if (embree.median > 0.0) row += format(" x%.2fE", rate.median / embree.median);

@@ -40,8 +40,10 @@ struct BenchCell {
   // tested against the previous one's occluder (Accel::occluder_run); 1
   // for closest-hit cells and structures without occluder runs.
   std::size_t occluder_run = 1;
-  // Whether its calls sorted the rays on the device first (Coherence::scattered,
-  // Accel::sorts): the kernel time then spans the sort and the trace.
+  // Of the timed calls, how many sorted the rays on the device first
+  // (Coherence::scattered, Accel::last_call_sorted): their kernel time
+  // spans the sort and the trace. `sorted`: more than half of them.
+  int sorted_runs = 0;
   bool sorted = false;
   // Embree's traversal of the same rays right after each timed launch (its
   // API as `packets` says), when the run has the baseline and Embree traces
@@ -84,7 +86,7 @@ struct BenchRun {
   std::size_t check_rays = 0;
   std::string precision;     // the structures' level: fast | robust | exact
   std::string embree_flags;  // Embree's scene flags: none (its default) | robust
-  bool sort_diffuse = false;  // diffuse rays traced as Coherence::scattered calls
+  std::string diffuse_sort = "measured";  // the diffuse calls' ScatteredSort (BenchOptions::diffuse_sort)
   std::vector<std::string> accels, scenes, ray_kinds;
   std::vector<BenchDevice> devices;
   std::vector<BenchSceneInfo> scene_info;

@@ -55,7 +55,7 @@ void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, cons
                     RunOptions options) {
   const Device& device = test_device();
   for (Precision level : test_precisions()) {
-    AccelConfig config{level};
+    AccelConfig config{level, {}, ScatteredSort::always};  // scattered calls: the sorted kernels
     auto brute = make_accel(device, "brute", geometry, config);
     std::vector<Hit> brute_hits[2] = {run_query(*brute, rays, Query::closest), run_query(*brute, rays, Query::any)};
     for (const std::string& name : tested_structures()) {

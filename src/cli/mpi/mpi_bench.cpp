@@ -23,7 +23,7 @@ namespace {
 
 nlohmann::json cell_json(const BenchCell& c) {
   return {{"scene", c.scene},       {"accel", c.accel},         {"rays", c.rays},
-          {"precision", c.precision}, {"packets", c.packets}, {"occluder_run", c.occluder_run}, {"sorted", c.sorted},
+          {"precision", c.precision}, {"packets", c.packets}, {"occluder_run", c.occluder_run}, {"sorted", c.sorted}, {"sorted_runs", c.sorted_runs},
           {"query", c.query},       {"ray_count", c.ray_count}, {"build_ms", c.build_ms},
           {"setup_ms", c.setup_ms}, {"first_launch_ms", c.first_launch_ms},
           {"device_bytes", c.device_bytes}, {"primitives", c.primitives},
@@ -41,6 +41,7 @@ BenchCell cell_of(const nlohmann::json& j, std::size_t device) {
   c.packets = j["packets"];
   c.occluder_run = j["occluder_run"];
   c.sorted = j["sorted"];
+  c.sorted_runs = j["sorted_runs"];
   c.query = j["query"];
   c.ray_count = j["ray_count"];
   c.build_ms = j["build_ms"];

@@ -22,12 +22,14 @@ Accel::Accel(const Device& device, std::string name, TraceKernels incoherent, st
       stats_(stats),
       precision_(config.precision),
       defines_(with_precision(device.info(), std::move(defines), config.precision)),
-      incoherent_{std::move(incoherent), {}, {}} {
+      incoherent_{std::move(incoherent), {}, {}},
+      sort_choices_{SortChoice(config.scattered_sort), SortChoice(config.scattered_sort)} {
   if (coherent) coherent_ = KernelSet{std::move(*coherent), {}, {}};
   const TraceKernels& single = incoherent_.spec;
-  if (single.rays_per_work_item == 1 && single.sortable && device.info().type == "cpu")
+  if (single.rays_per_work_item == 1 && single.sortable && device.info().type == "cpu" &&
+      config.scattered_sort != ScatteredSort::never)
     scattered_ = KernelSet{single, {}, {}, true};
-  kernel_for(Coherence::incoherent, Query::closest);
+  kernel_for(incoherent_, Query::closest);
 }
 
 Accel::KernelSet& Accel::set_for(Coherence coherence) const {
@@ -38,8 +40,7 @@ Accel::KernelSet& Accel::set_for(Coherence coherence) const {
 
 bool Accel::sorts(Coherence coherence) const { return set_for(coherence).ordered; }
 
-Accel::QueryKernel& Accel::kernel_for(Coherence coherence, Query query) const {
-  KernelSet& set = set_for(coherence);
+Accel::QueryKernel& Accel::kernel_for(KernelSet& set, Query query) const {
   std::optional<QueryKernel>& slot = query == Query::closest ? set.closest : set.any;
   if (slot) return *slot;
   std::vector<std::string> defines = defines_;
@@ -51,6 +52,34 @@ Accel::QueryKernel& Accel::kernel_for(Coherence coherence, Query query) const {
   std::string kernel_name = (query == Query::closest ? "trace_closest_" : "trace_any_") + stem;
   with_cl_errors([&] { slot = QueryKernel{cl::Kernel(program, kernel_name.c_str()), false}; });
   return *slot;
+}
+
+bool Accel::sort_this_call(Coherence coherence, Query query) const {
+  if (coherence != Coherence::scattered || !scattered_) return false;
+  record_pending(query);
+  return sort_choices_[query == Query::closest ? 0 : 1].next();
+}
+
+bool Accel::sort_choice_settled(Query query) const {
+  if (!scattered_) return true;
+  record_pending(query);
+  return sort_choices_[query == Query::closest ? 0 : 1].settled();
+}
+
+void Accel::record_pending(Query query) const {
+  std::size_t q = query == Query::closest ? 0 : 1;
+  if (std::optional<PendingCall>& pending = pending_[q]) {
+    cl_int status = pending->done.getInfo<CL_EVENT_COMMAND_EXECUTION_STATUS>();
+    if (status == CL_COMPLETE) {
+      double ms = static_cast<double>(pending->done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
+                                      pending->first.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+                  1e-6;
+      sort_choices_[q].record(pending->sorted, ms / static_cast<double>(pending->ray_count));
+      pending.reset();
+    } else if (status < 0) {
+      pending.reset();  // failed: nothing to learn from it
+    }
+  }
 }
 
 std::size_t Accel::rays_per_work_item(Coherence coherence) const { return set_for(coherence).spec.rays_per_work_item; }
@@ -68,8 +97,10 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     if (hit_bytes < ray_count * sizeof(Hit))
       throw Error(name_ + " trace: hit buffer holds " + std::to_string(hit_bytes / sizeof(Hit)) + " hits, " +
                   std::to_string(ray_count) + " requested");
-    QueryKernel& slot = kernel_for(coherence, query);
-    const KernelSet& set = set_for(coherence);
+    bool sorted = ray_count > 0 && sort_this_call(coherence, query);
+    KernelSet& set = sorted ? *scattered_ : set_for(coherence == Coherence::scattered ? Coherence::incoherent : coherence);
+    QueryKernel& slot = kernel_for(set, query);
+    last_sorted_ = sorted;
     if (!slot.args_set) {
       set_structure_args(slot.kernel, set.ordered ? 4 : 3);
       slot.args_set = true;
@@ -106,6 +137,10 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
                                          fixed ? cl::NDRange(group) : cl::NullRange,
                                          before.empty() ? nullptr : &before, &done);
     if (!set.ordered) first_event_ = done;
+    std::size_t q = query == Query::closest ? 0 : 1;
+    if (coherence == Coherence::scattered && scattered_ && device_.profiling() && !pending_[q] && slot.launches > 0)
+      pending_[q] = PendingCall{sorted, first_event_, done, ray_count};
+    ++slot.launches;
     return done;
   });
 }

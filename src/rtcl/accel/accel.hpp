@@ -3,6 +3,7 @@
 // never depend on which structure answers.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -14,6 +15,7 @@
 #include "rtcl/accel/options.hpp"
 #include "rtcl/accel/precision.hpp"
 #include "rtcl/accel/ray_sort.hpp"
+#include "rtcl/accel/sort_choice.hpp"
 #include "rtcl/cl/device.hpp"
 #include "rtcl/scene/geometry.hpp"
 
@@ -42,12 +44,14 @@ enum class Coherence {
   coherent,
   // Many rays whose neighbours are unrelated: diffuse and glossy bounces
   // from hits in pixel order. On CPU devices a structure with a single-ray
-  // kernel first sorts them on the device by their origin's cell and
-  // direction's octant (RaySort, rtcl/accel/ray_sort.hpp), traces them in
-  // that order and writes each hit at its ray's index: one more pass over
+  // kernel may first sort them on the device by their origin's cell and
+  // direction's octant (RaySort, rtcl/accel/ray_sort.hpp), trace them in
+  // that order and write each hit at its ray's index: one more pass over
   // the rays and two over their keys, which pay where a ray visits many
-  // nodes (README "Scattered rays sorted on the device"). Elsewhere as
-  // incoherent.
+  // nodes (README "Scattered rays sorted on the device"). Whether a call
+  // sorts is AccelConfig::scattered_sort's choice; by default the faster
+  // way as the structure's earlier scattered calls measured it
+  // (SortChoice). Elsewhere as incoherent.
   scattered,
 };
 
@@ -58,6 +62,9 @@ struct AccelConfig {
   // its declaration by make_accel; absent ones take the declared defaults
   // (`rtcl structures` lists them).
   AccelOptions options;
+  // Whether Coherence::scattered calls sort (SortChoice): measured, always
+  // or never.
+  ScatteredSort scattered_sort = ScatteredSort::measured;
 };
 
 struct AccelStats {
@@ -89,8 +96,18 @@ class Accel {
   // against the leaf that blocked the previous one; 1: no such test.
   std::size_t occluder_run(Coherence coherence) const;
 
-  // Whether calls of this coherence sort the rays first (Coherence::scattered).
+  // Whether calls of this coherence may sort the rays first
+  // (Coherence::scattered on a CPU device, a single-ray kernel, and
+  // AccelConfig::scattered_sort not `never`).
   bool sorts(Coherence coherence) const;
+  // Whether the latest trace call sorted its rays.
+  bool last_call_sorted() const { return last_sorted_; }
+  // Whether the choice for scattered calls of this query is made: both ways
+  // measured (each after its first launch, whose time includes PoCL's code
+  // generation and the buffers' first touch), or a policy other than
+  // `measured`, or calls that never sort. Records a finished pending call
+  // first. A benchmark warms up until it holds.
+  bool sort_choice_settled(Query query) const;
 
   // The -D options (and -cl-... flags) its trace programs are built with,
   // before the query's RTCL_QUERY_CLOSEST / RTCL_QUERY_ANY.
@@ -156,6 +173,7 @@ class Accel {
   struct QueryKernel {
     cl::Kernel kernel;
     bool args_set = false;  // set_structure_args done (at its first trace: the constructor runs before the structure exists)
+    std::uint64_t launches = 0;
   };
   // One kernel per query of one TraceKernels, each built at its first use;
   // `ordered`: built with RTCL_TRACE_ORDER, its argument 3 the sort's order.
@@ -165,7 +183,18 @@ class Accel {
     bool ordered = false;
   };
   KernelSet& set_for(Coherence coherence) const;
-  QueryKernel& kernel_for(Coherence coherence, Query query) const;
+  QueryKernel& kernel_for(KernelSet& set, Query query) const;
+  // Whether this call of the coherence sorts: asks the query's SortChoice,
+  // after recording the query's pending measured call if it has finished.
+  bool sort_this_call(Coherence coherence, Query query) const;
+  void record_pending(Query query) const;
+
+  // A scattered call whose device time is still to be recorded.
+  struct PendingCall {
+    bool sorted = false;
+    cl::Event first, done;
+    std::size_t ray_count = 0;
+  };
 
   Device device_;
   std::string name_;
@@ -176,6 +205,10 @@ class Accel {
   mutable std::optional<KernelSet> coherent_, scattered_;
   mutable std::unique_ptr<RaySort> sort_;  // at the first call that sorts
   mutable cl::Event first_event_;
+  mutable bool last_sorted_ = false;
+  // Per query (closest, any): the choice and its call in flight.
+  mutable std::array<SortChoice, 2> sort_choices_;
+  mutable std::array<std::optional<PendingCall>, 2> pending_;
 };
 
 // Names make_accel accepts, in the order benchmarks list them.
