@@ -7,6 +7,7 @@
 
 #include "rtcl/accel/bvh_presplit.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/huge_pages.hpp"
 #include "rtcl/parallel.hpp"
 
 namespace rtcl {
@@ -109,6 +110,7 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config, st
     // The SAH builder's own array filled here, without box and id arrays
     // in between (README, "The SAH builder's input").
     auto refs = std::make_unique_for_overwrite<SahRef[]>(triangles);
+    advise_huge_pages(refs.get(), triangles * sizeof(SahRef));
     const std::size_t kept = for_each_kept_triangle(
         geometry, bvh_thread_count(config),
         [&](std::size_t k, std::uint32_t i, const Aabb& box) { refs[k] = SahRef::of(box, i); },

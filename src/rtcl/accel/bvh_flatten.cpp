@@ -31,6 +31,7 @@
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/bvh_collapse.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/huge_pages.hpp"
 #include "rtcl/parallel.hpp"
 
 namespace rtcl {
@@ -254,8 +255,10 @@ class Flattener {
     }
     if (end.nodes > 0x7fffffffu) fail("too many nodes");
     out_.nodes = std::move(top.nodes);
+    reserve_advised(out_.nodes, end.nodes);
     out_.nodes.resize(end.nodes);
     triangle_sources_ = std::move(top.triangle_sources);
+    reserve_advised(triangle_sources_, end.triangles);
     triangle_sources_.resize(end.triangles);
     sphere_sources_ = std::move(top.sphere_sources);
     sphere_sources_.resize(end.spheres);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rtcl/error.hpp"
+#include "rtcl/huge_pages.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/parallel.hpp"
 #include "rtcl/thread_pool.hpp"
@@ -167,6 +168,7 @@ class SahBuilder {
     tasks_.push_back({new_subtree(ref_count_), root_, 1});
     run_jobs(thread_count_, [this](unsigned) { work(); });
     assemble(tree.nodes);
+    reserve_advised(tree.prims, ref_count_);
     tree.prims.resize(ref_count_);
     for_each_part(ref_count_, part_count(ref_count_, thread_count_, config_.parallel_min_primitives),
                   [&](unsigned, std::size_t begin, std::size_t end) {
@@ -521,7 +523,7 @@ class SahBuilder {
   // mutex held); n: its references, for the room its nodes take.
   std::uint32_t new_subtree(std::size_t n) {
     auto nodes = std::make_unique<std::vector<BuildNode>>();
-    nodes->reserve(n / 2 + 1);
+    reserve_advised(*nodes, n / 2 + 1);
     nodes->emplace_back();
     subtrees_.push_back(std::move(nodes));
     return static_cast<std::uint32_t>(subtrees_.size() - 1);
@@ -537,6 +539,7 @@ class SahBuilder {
       first[k] = static_cast<std::uint32_t>(total);
       total += subtrees_[k]->size();
     }
+    reserve_advised(out, total);
     out.resize(total);
     for_each_index(subtrees_.size(), thread_count_, [&](std::size_t k) {
       BuildNode* to = out.data() + first[k];
