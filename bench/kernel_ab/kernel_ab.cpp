@@ -34,7 +34,9 @@
 // Embree), AB_SETS (the ray sets to time, e.g. "primary,shadow"; default
 // all three), AB_MORTON_ORDER (set: every timed set traced, by every
 // version and Embree, in the host's Morton order of render/ray_order.hpp
-// instead of the camera's row order), AB_REPEAT_RAYS (N in 1 .. 1024: every
+// instead of the camera's row order), AB_PACKET_TILES (set: the primary
+// rays in rtcl bench's packet-tile order, render/ray_order.hpp's
+// packet_tile_order, instead of row order), AB_REPEAT_RAYS (N in 1 .. 1024: every
 // timed set's rays replaced by every N-th ray, each traced N times in a row,
 // by every version and Embree: the same count of rays, whose caches and
 // branch history then see each path N times), RTCL_BENCH_RES,
@@ -102,6 +104,7 @@ int run(int argc, char** argv) {
     if (name != "primary" && name != "shadow" && name != "diffuse")
       throw Error("AB_SETS: unknown ray set '" + name + "' (known: primary, shadow, diffuse)");
   const bool morton = std::getenv("AB_MORTON_ORDER") != nullptr;
+  const bool packet_tiles = std::getenv("AB_PACKET_TILES") != nullptr;
   const char* repeat_env = std::getenv("AB_REPEAT_RAYS");
   const int repeat = repeat_env && *repeat_env ? std::atoi(repeat_env) : 1;
   if (repeat < 1 || repeat > 1024)
@@ -144,6 +147,7 @@ int run(int argc, char** argv) {
     };
 
     std::vector<Ray> primary = primary_rays(spec.camera, res, res);
+    if (packet_tiles) primary = gather<Ray>(primary, packet_tile_order(res, res));
     std::vector<Hit> primary_hits;
     launch(0, Query::closest, primary, &primary_hits);
     SecondaryRays secondary = secondary_rays(geometry, primary, primary_hits, spec.light);

@@ -26,6 +26,9 @@ typedef struct TracePacket {
   float8 dx, dy, dz;
   float8 tmax;
   int8 active;
+  /* every lane's permutation is (axis_x, axis_y, axis_z) (-1: they differ):
+   * the triangle tests then pick each vertex coordinate once per packet */
+  int axis_x, axis_y, axis_z;
 } TracePacket;
 
 /* Lane-wise a[k] for a per-lane axis index given as masks k == 1, k == 2. */
@@ -86,6 +89,11 @@ inline void packet_setup(global const Ray* rays, uint first, uint ray_count, Tra
   p->kx1 = tx == 1; p->kx2 = tx == 2;
   p->ky1 = ty == 1; p->ky2 = ty == 2;
   p->kz1 = kz == 1; p->kz2 = kz == 2;
+  int lx = tx.s0, ly = ty.s0, lz = kz.s0;
+  int same = !rtcl_any8((tx != (int8)(lx)) | (ty != (int8)(ly)) | (kz != (int8)(lz)));
+  p->axis_x = same ? lx : -1;
+  p->axis_y = ly;
+  p->axis_z = lz;
   p->ox = ox; p->oy = oy; p->oz = oz; p->tmin = tmin;
   p->dx = dx; p->dy = dy; p->dz = dz;
   p->ix = 1.0f / dx;
@@ -157,7 +165,13 @@ inline int8 packet_triangle_at(global const float* at, int stride, int prim, con
                                int8 mask) {
   /* vertex j's coordinates on each ray's permuted axes */
   float8 v[3][3];
-  for (int j = 0; j < 3; ++j) {
+  if (p->axis_x >= 0) {
+    for (int j = 0; j < 3; ++j) {
+      v[j][0] = (float8)(at[(3 * j + p->axis_x) * stride]);
+      v[j][1] = (float8)(at[(3 * j + p->axis_y) * stride]);
+      v[j][2] = (float8)(at[(3 * j + p->axis_z) * stride]);
+    }
+  } else for (int j = 0; j < 3; ++j) {
     float8 x = (float8)(at[(3 * j) * stride]), y = (float8)(at[(3 * j + 1) * stride]), z = (float8)(at[(3 * j + 2) * stride]);
     v[j][0] = rtcl_pick_axis(x, y, z, p->kx1, p->kx2);
     v[j][1] = rtcl_pick_axis(x, y, z, p->ky1, p->ky2);
