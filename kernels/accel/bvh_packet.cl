@@ -4,10 +4,10 @@
  * (packet traversal, Wald, Slusallek, Benthin, Wagner 2001, "Interactive
  * rendering with coherent ray tracing"), in one of two ways:
  *  - as one frustum (bvh_frustum_traverse) when the packet's valid rays
- *    share a direction octant and have finite reciprocals: a node's eight
- *    child boxes in one float8 test against bounds of all eight rays, as a
- *    single ray's; at a leaf the rays that enter its box test the triangles
- *    whose boxes the frustum meets;
+ *    share a direction octant, have finite reciprocals and tmin >= 0: a
+ *    node's eight child boxes in one float8 test against bounds of all
+ *    eight rays, as a single ray's; at a leaf the rays that enter its box
+ *    test the triangles whose boxes the frustum meets;
  *  - ray by ray in the lanes otherwise: per node, each child box is tested
  *    against the packet's rays at once; per leaf, each primitive is tested
  *    against them at once. The packet shares one stack; each entry carries
@@ -62,8 +62,8 @@ inline int8 packet_triangle(global const TriangleBlock* block, int k, const Trac
 
 /* The packet as one frustum (after Embree's traversal of coherent
  * packets): when its active rays move the same way along each axis (one
- * direction octant) and have finite reciprocals, a node's eight child
- * boxes are tested against bounds of all its rays at once
+ * direction octant), have finite reciprocals and tmin >= 0, a node's eight
+ * child boxes are tested against bounds of all its rays at once
  * (rtcl_frustum_slabs8: the origins' box, the reciprocals' range), one
  * float8 test per node as for a single ray, where the per-ray traversal
  * tests each child against the eight rays in turn. The test is
@@ -76,8 +76,9 @@ inline int8 packet_triangle(global const TriangleBlock* block, int k, const Trac
 typedef struct PacketFrustum {
   float onx, ony, onz;          /* origin bound for the entry planes */
   float ofx, ofy, ofz;          /* ... for the exit planes */
-  float lx, ly, lz, hx, hy, hz; /* reciprocal direction range per axis */
-  float tmin;                   /* the active rays' smallest tmin */
+  float rnx, rny, rnz;          /* reciprocal direction of least magnitude per axis */
+  float rfx, rfy, rfz;          /* ... of greatest magnitude */
+  float tmin;                   /* the active rays' smallest tmin (>= 0) */
   int near_x, near_y, near_z, far_x, far_y, far_z; /* bounds rows, as in TraceRay */
 } PacketFrustum;
 
@@ -86,7 +87,7 @@ inline float packet_min(float8 v, int8 lanes) { return rtcl_min8_ordered(select(
 inline float packet_max(float8 v, int8 lanes) { return rtcl_max8_ordered(select((float8)(-INFINITY), v, lanes)); }
 
 /* Fills *f and returns 1 when the packet's active rays share a direction
- * octant and have finite reciprocals, else returns 0. */
+ * octant, have finite reciprocals and tmin >= 0, else returns 0. */
 inline int packet_frustum(const TracePacket* p, PacketFrustum* f) {
   int8 a = p->active;
   int8 finite = rtcl_is_finite8(p->ix) & rtcl_is_finite8(p->iy) & rtcl_is_finite8(p->iz);
@@ -104,13 +105,17 @@ inline int packet_frustum(const TracePacket* p, PacketFrustum* f) {
   f->ofy = pos_y ? oy_lo : oy_hi;
   f->onz = pos_z ? oz_hi : oz_lo;
   f->ofz = pos_z ? oz_lo : oz_hi;
-  f->lx = packet_min(p->ix, a);
-  f->hx = packet_max(p->ix, a);
-  f->ly = packet_min(p->iy, a);
-  f->hy = packet_max(p->iy, a);
-  f->lz = packet_min(p->iz, a);
-  f->hz = packet_max(p->iz, a);
   f->tmin = packet_min(p->tmin, a);
+  if (!(f->tmin >= 0.0f)) return 0;
+  float lx = packet_min(p->ix, a), hx = packet_max(p->ix, a);
+  float ly = packet_min(p->iy, a), hy = packet_max(p->iy, a);
+  float lz = packet_min(p->iz, a), hz = packet_max(p->iz, a);
+  f->rnx = pos_x ? lx : hx;
+  f->rfx = pos_x ? hx : lx;
+  f->rny = pos_y ? ly : hy;
+  f->rfy = pos_y ? hy : ly;
+  f->rnz = pos_z ? lz : hz;
+  f->rfz = pos_z ? hz : lz;
   f->near_x = pos_x ? 0 : 3;
   f->near_y = pos_y ? 1 : 4;
   f->near_z = pos_z ? 2 : 5;
@@ -134,7 +139,7 @@ inline int frustum_triangles(global const TriangleBlock* block, const PacketFrus
   float8 tn, tf;
   rtcl_frustum_slabs8(f->near_x == 0 ? lo[0] : hi[0], f->near_y == 1 ? lo[1] : hi[1], f->near_z == 2 ? lo[2] : hi[2],
                       f->near_x == 0 ? hi[0] : lo[0], f->near_y == 1 ? hi[1] : lo[1], f->near_z == 2 ? hi[2] : lo[2],
-                      f->onx, f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->lx, f->ly, f->lz, f->hx, f->hy, f->hz,
+                      f->onx, f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->rnx, f->rny, f->rnz, f->rfx, f->rfy, f->rfz,
                       f->tmin, tmax, &tn, &tf);
   return rtcl_lane_bits8((tn <= tf) & (vload8(0, block->prim) >= 0));
 }
@@ -190,7 +195,7 @@ __attribute__((noinline)) int bvh_frustum_traverse(const TracePacket* p, const P
       global const float8* b = (global const float8*)node->bounds;
       float8 t_entry, t_exit;
       rtcl_frustum_slabs8(b[f->near_x], b[f->near_y], b[f->near_z], b[f->far_x], b[f->far_y], b[f->far_z], f->onx,
-                          f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->lx, f->ly, f->lz, f->hx, f->hy, f->hz, f->tmin,
+                          f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->rnx, f->rny, f->rnz, f->rfx, f->rfy, f->rfz, f->tmin,
                           t_far, &t_entry, &t_exit);
       int8 hit = t_entry <= t_exit;
       if (rtcl_any8(hit)) {

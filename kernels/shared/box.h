@@ -60,24 +60,29 @@ RTCL_LANES_INLINE void rtcl_slabs8(float8 nx, float8 ny, float8 nz, float8 fx, f
 
 /* The slab arithmetic of a whole packet at once (the packet kernel's
  * frustum traversal, kernels/accel/bvh_packet.cl): the rays' origins lie
- * in a box and their reciprocal directions in [lo, hi] per axis, of one
- * sign per axis. Per axis the entry distance is bounded below by
- * min(A * lo, A * hi), A = entry plane - the origin bound that makes it
- * smallest (the largest origin coordinate where the direction is
- * positive, the smallest where it is negative: on = that bound), and the
- * exit distance above by max(B * lo, B * hi), B = exit plane - of (the
- * other bound). Float rounding is monotone, so these bounds hold for
- * every ray's own rtcl_slabs8 distances too (widened alike, monotone
- * again): a box this test rejects, every ray of the packet rejects. Needs
- * finite reciprocals (no NaN arises then). */
+ * in a box, their reciprocal directions in a range of one sign per axis,
+ * and their tmin >= 0. Per axis the entry distance is bounded below by
+ * A * rn, A = entry plane - the origin bound that makes it smallest (the
+ * largest origin coordinate where the direction is positive, the smallest
+ * where it is negative: on = that bound), rn = the reciprocal of least
+ * magnitude: that is min(A * lo, A * hi) where A >= 0 (the plane ahead),
+ * and a negative bound where A < 0, which the max with tmin >= 0 then
+ * drops, as it drops every ray's own. The exit distance is bounded above
+ * by B * rf, B = exit plane - of (the other bound), rf = the reciprocal of
+ * greatest magnitude: max(B * lo, B * hi) where B >= 0; where B < 0 it is
+ * negative, so below the entry, and the box is rejected, as every ray's
+ * own exit is negative there too. Float rounding is monotone, so these
+ * bounds hold for every ray's own rtcl_slabs8 distances (widened alike,
+ * monotone again): a box this test rejects, every ray of the packet
+ * rejects. One multiplication per plane where min(A * lo, A * hi) takes
+ * two and a min (measured: README "Packet kernel levers"). Needs finite
+ * reciprocals (no NaN arises then). */
 RTCL_LANES_INLINE void rtcl_frustum_slabs8(float8 nx, float8 ny, float8 nz, float8 fx, float8 fy, float8 fz,
                                            float onx, float ony, float onz, float ofx, float ofy, float ofz,
-                                           float lx, float ly, float lz, float hx, float hy, float hz, float tmin,
-                                           float tmax, float8* tn, float8* tf) {
-  float8 ax = nx - onx, ay = ny - ony, az = nz - onz;
-  float8 bx = fx - ofx, by = fy - ofy, bz = fz - ofz;
-  float8 tnx = rtcl_fmin8(ax * lx, ax * hx), tny = rtcl_fmin8(ay * ly, ay * hy), tnz = rtcl_fmin8(az * lz, az * hz);
-  float8 tfx = rtcl_fmax8(bx * lx, bx * hx), tfy = rtcl_fmax8(by * ly, by * hy), tfz = rtcl_fmax8(bz * lz, bz * hz);
+                                           float rnx, float rny, float rnz, float rfx, float rfy, float rfz,
+                                           float tmin, float tmax, float8* tn, float8* tf) {
+  float8 tnx = (nx - onx) * rnx, tny = (ny - ony) * rny, tnz = (nz - onz) * rnz;
+  float8 tfx = (fx - ofx) * rfx, tfy = (fy - ofy) * rfy, tfz = (fz - ofz) * rfz;
   *tn = rtcl_fmax8(tnx, rtcl_fmax8(tny, rtcl_fmax8(tnz, (float8)(tmin))));
   *tf = rtcl_fmin8(tfx, rtcl_fmin8(tfy, rtcl_fmin8(tfz, (float8)(tmax))));
   rtcl_widen_slab(tn, tf);
