@@ -71,8 +71,8 @@ inline int8 packet_triangle(global const TriangleBlock* block, int k, const Trac
  * with its own arithmetic, and a ray's closest hit does not depend on
  * which extra boxes were visited: the hits are the per-ray traversal's.
  * Children are pushed nearest first by the frustum's entry distance
- * (shared/bvh8_stack.h, as accel/bvh.cl); an entry beyond every ray's
- * current best hit is skipped. */
+ * (shared/bvh8_stack.h, as accel/bvh.cl), the nearest visited next without
+ * the stack; an entry beyond every ray's current best hit is skipped. */
 typedef struct PacketFrustum {
   float onx, ony, onz;          /* origin bound for the entry planes */
   float ofx, ofy, ofz;          /* ... for the exit planes */
@@ -182,6 +182,7 @@ __attribute__((noinline)) int bvh_frustum_traverse(const TracePacket* p, const P
                                                     global const Bvh8Node* nodes,
                                                     global const TriangleBlock* triangles,
                                                     global const SphereBlock* spheres) {
+  const PacketFrustum fr = *f; /* in registers: the stack's stores do not reload it */
   int stack_ref[RTCL_STACK_SIZE]; /* child slots: 8 * node + lane */
   float stack_t[RTCL_STACK_SIZE]; /* the frustum's entry distance of the slot's box */
   int sp = 0;
@@ -194,12 +195,15 @@ __attribute__((noinline)) int bvh_frustum_traverse(const TracePacket* p, const P
       global const Bvh8Node* node = nodes + ref;
       global const float8* b = (global const float8*)node->bounds;
       float8 t_entry, t_exit;
-      rtcl_frustum_slabs8(b[f->near_x], b[f->near_y], b[f->near_z], b[f->far_x], b[f->far_y], b[f->far_z], f->onx,
-                          f->ony, f->onz, f->ofx, f->ofy, f->ofz, f->rnx, f->rny, f->rnz, f->rfx, f->rfy, f->rfz, f->tmin,
+      rtcl_frustum_slabs8(b[fr.near_x], b[fr.near_y], b[fr.near_z], b[fr.far_x], b[fr.far_y], b[fr.far_z], fr.onx,
+                          fr.ony, fr.onz, fr.ofx, fr.ofy, fr.ofz, fr.rnx, fr.rny, fr.rnz, fr.rfx, fr.rfy, fr.rfz, fr.tmin,
                           t_far, &t_entry, &t_exit);
       int8 hit = t_entry <= t_exit;
       if (rtcl_any8(hit)) {
-        RTCL_BVH8_PUSH_CHILDREN
+        RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST
+        slot = near_entry;
+        ref = node->child[slot & 7];
+        continue;
       }
     } else {
       /* the rays that enter the leaf's own box, as the per-ray traversal has them */
