@@ -162,9 +162,11 @@ TEST(BvhPacket, MatchesReferenceOnIncoherentRaysWithSpheres) {
 
 // Packets whose rays share one direction octant take the frustum
 // traversal (one box test per node for the whole packet): loose frusta
-// (origins spread over the scene), tight ones, rays aimed exactly at mesh
-// vertices (which lie on leaf box faces), triangles beside spheres, an
-// invalid ray in an otherwise frustum-shaped packet, axis-parallel rays;
+// (origins spread over the scene, each ray tested against a leaf's box),
+// tight ones (one origin: no such test), rays aimed exactly at mesh
+// vertices (which lie on leaf box faces) from spread origins and from one,
+// triangles beside spheres, an invalid ray in an otherwise frustum-shaped
+// packet, packets with tmin < 0 (not a frustum), axis-parallel rays;
 // at every precision level, answers as the single-ray kernel's and (robust,
 // exact) the double-precision reference's.
 TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
@@ -190,6 +192,17 @@ TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
       rays.push_back({o.x, o.y, o.z, d.x, d.y, d.z, 0.0f, kInf});
     }
   }
+  for (int p = 0; p < 60; ++p) {  // one origin each (tight frusta): aimed at vertices, or from inside with tmin < 0
+    glm::vec3 sign(unit(rng) < 0.5f ? -1.0f : 1.0f, unit(rng) < 0.5f ? -1.0f : 1.0f, unit(rng) < 0.5f ? -1.0f : 1.0f);
+    glm::vec3 o = glm::vec3(unit(rng), unit(rng), unit(rng)) - 1.5f * sign;
+    bool behind = p % 5 == 4;  // not a frustum: the rays start inside the scene at tmin = -0.5
+    if (behind) o += 1.5f * sign;
+    for (int l = 0; l < 8; ++l) {
+      glm::vec3 v = g.vertices[static_cast<std::size_t>(unit(rng) * static_cast<float>(g.vertices.size() - 1))];
+      glm::vec3 d = behind ? sign * glm::vec3(0.05f + unit(rng), 0.05f + unit(rng), 0.05f + unit(rng)) : v - o;
+      rays.push_back({o.x, o.y, o.z, d.x, d.y, d.z, behind ? -0.5f : 0.0f, kInf});
+    }
+  }
   rays[8 * 5 + 3].dx = kNaN;  // inactive lane in a frustum packet
   for (int l = 0; l < 8; ++l) {  // axis-parallel rays (infinite reciprocals): not a frustum
     float y = 0.1f + 0.1f * static_cast<float>(l);
@@ -208,7 +221,7 @@ TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
           ASSERT_EQ(got[i].prim >= 0, expected[i].prim >= 0) << "ray " << i;
           if (q == Query::closest && got[i].prim >= 0)
-            EXPECT_NEAR(got[i].t, expected[i].t, 1e-5f * expected[i].t) << "ray " << i;
+            EXPECT_NEAR(got[i].t, expected[i].t, 1e-5f * std::abs(expected[i].t)) << "ray " << i;
         }
       }
       continue;

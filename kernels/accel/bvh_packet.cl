@@ -3,11 +3,12 @@
  * float8 lanes hold the eight rays instead of a node's eight children
  * (packet traversal, Wald, Slusallek, Benthin, Wagner 2001, "Interactive
  * rendering with coherent ray tracing"), in one of two ways:
- *  - as one frustum (bvh_frustum_traverse) when the packet's valid rays
+ *  - as one frustum (bvh_frustum_walk) when the packet's valid rays
  *    share a direction octant, have finite reciprocals and tmin >= 0: a
  *    node's eight child boxes in one float8 test against bounds of all
- *    eight rays, as a single ray's; at a leaf the rays that enter its box
- *    test the triangles whose boxes the frustum meets;
+ *    eight rays, as a single ray's; at a leaf the rays (those that enter
+ *    its box, where their origins differ) test the triangles whose boxes
+ *    the frustum meets;
  *  - ray by ray in the lanes otherwise: per node, each child box is tested
  *    against the packet's rays at once; per leaf, each primitive is tested
  *    against them at once. The packet shares one stack; each entry carries
@@ -22,14 +23,16 @@
  * slab distances and the same triangle tests, lane by lane, so closest-hit
  * t is bit-identical to the single-ray kernel (at the robust and fast levels
  * the primitive may differ between two at exactly the same t; at the exact
- * level the smaller id wins there too). Any hit reports some hit.
+ * level the smaller id wins there too). At the fast level, whose slab tests
+ * are not widened, a hit on a triangle that lies on a box's face may be
+ * found by one kernel and not the other (the frustum visits boxes a ray's
+ * own test rejects). Any hit reports some hit.
  *
  * Stack bound: as in accel/bvh.cl (a node pushes at most its children and
  * pops one), so the host's RTCL_STACK_SIZE is valid here too, for both ways.
  * Measured: README "Packet kernel levers". */
-/* The frustum traversal's stack holds child slots (8 * node + lane), so
- * that a leaf's rays can be tested against its own box. */
-#define RTCL_BVH8_ENTRY(k) (8 * ref + (k))
+/* What the frustum traversal pushes (bvh_frustum_walk) */
+#define RTCL_BVH8_ENTRY(k) (loose ? 8 * ref + (k) : node->child[k])
 #include "shared/bvh8_stack.h"
 #include "shared/packet.h"
 
@@ -79,6 +82,7 @@ typedef struct PacketFrustum {
   float rnx, rny, rnz;          /* reciprocal direction of least magnitude per axis */
   float rfx, rfy, rfz;          /* ... of greatest magnitude */
   float tmin;                   /* the active rays' smallest tmin (>= 0) */
+  int loose;                    /* the rays' origins differ */
   int near_x, near_y, near_z, far_x, far_y, far_z; /* bounds rows, as in TraceRay */
 } PacketFrustum;
 
@@ -107,6 +111,7 @@ inline int packet_frustum(const TracePacket* p, PacketFrustum* f) {
   f->ofz = pos_z ? oz_lo : oz_hi;
   f->tmin = packet_min(p->tmin, a);
   if (!(f->tmin >= 0.0f)) return 0;
+  f->loose = ox_lo != ox_hi || oy_lo != oy_hi || oz_lo != oz_hi;
   float lx = packet_min(p->ix, a), hx = packet_max(p->ix, a);
   float ly = packet_min(p->iy, a), hy = packet_max(p->iy, a);
   float lz = packet_min(p->iz, a), hz = packet_max(p->iz, a);
@@ -177,14 +182,19 @@ inline void packet_leaf(int leaf, const TracePacket* p, const PacketFrustum* f, 
   }
 }
 
-/* Returns the last leaf that blocked rays of the packet (any hit), else -1. */
-__attribute__((noinline)) int bvh_frustum_traverse(const TracePacket* p, const PacketFrustum* f, PacketHits* h,
-                                                    global const Bvh8Node* nodes,
-                                                    global const TriangleBlock* triangles,
-                                                    global const SphereBlock* spheres) {
+/* The frustum traversal; `loose` (a constant in each caller) when the
+ * rays' origins differ: then the frustum holds far more than the rays,
+ * and a leaf's rays are first tested against its own box (per ray, as the
+ * per-ray traversal does), for which the stack holds child slots
+ * (8 * node + lane). Tight frusta (one origin) skip that test: a triangle
+ * a ray hits lies in a box the ray enters, so the hits are the same.
+ * Returns the last leaf that blocked rays of the packet (any hit), else -1. */
+RTCL_LANES_INLINE int bvh_frustum_walk(const TracePacket* p, const PacketFrustum* f, PacketHits* h,
+                                       global const Bvh8Node* nodes, global const TriangleBlock* triangles,
+                                       global const SphereBlock* spheres, const int loose) {
   const PacketFrustum fr = *f; /* in registers: the stack's stores do not reload it */
-  int stack_ref[RTCL_STACK_SIZE]; /* child slots: 8 * node + lane */
-  float stack_t[RTCL_STACK_SIZE]; /* the frustum's entry distance of the slot's box */
+  int stack_ref[RTCL_STACK_SIZE]; /* child references (tight) or slots (loose) */
+  float stack_t[RTCL_STACK_SIZE]; /* the frustum's entry distance of the entry's box */
   int sp = 0;
   int ref = 0, slot = 0;
   int8 alive = p->active; /* any hit: rays still looking */
@@ -202,15 +212,13 @@ __attribute__((noinline)) int bvh_frustum_traverse(const TracePacket* p, const P
       if (rtcl_any8(hit)) {
         RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST
         slot = near_entry;
-        ref = node->child[slot & 7];
+        ref = loose ? node->child[slot & 7] : slot;
         continue;
       }
     } else {
-      /* the rays that enter the leaf's own box, as the per-ray traversal has them */
-      float8 tn = packet_box(nodes + (slot >> 3), slot & 7, p, h->t_best, alive);
-      int8 mask = rtcl_not_nan8(tn);
+      int8 before = alive, mask = alive;
+      if (loose) mask = rtcl_not_nan8(packet_box(nodes + (slot >> 3), slot & 7, p, h->t_best, alive));
       if (rtcl_any8(mask)) {
-        int8 before = alive;
         packet_leaf(~ref, p, f, h, triangles, spheres, &alive, &mask);
         if (RTCL_ANY_HIT && rtcl_any8(before & ~alive)) {
           blocker = ~ref;
@@ -224,8 +232,22 @@ __attribute__((noinline)) int bvh_frustum_traverse(const TracePacket* p, const P
       --sp;
     } while (!RTCL_ANY_HIT && stack_t[sp] > t_far);
     slot = stack_ref[sp];
-    ref = nodes[slot >> 3].child[slot & 7];
+    ref = loose ? nodes[slot >> 3].child[slot & 7] : slot;
   }
+}
+
+__attribute__((noinline)) int bvh_frustum_traverse_tight(const TracePacket* p, const PacketFrustum* f, PacketHits* h,
+                                                          global const Bvh8Node* nodes,
+                                                          global const TriangleBlock* triangles,
+                                                          global const SphereBlock* spheres) {
+  return bvh_frustum_walk(p, f, h, nodes, triangles, spheres, 0);
+}
+
+__attribute__((noinline)) int bvh_frustum_traverse_loose(const TracePacket* p, const PacketFrustum* f, PacketHits* h,
+                                                          global const Bvh8Node* nodes,
+                                                          global const TriangleBlock* triangles,
+                                                          global const SphereBlock* spheres) {
+  return bvh_frustum_walk(p, f, h, nodes, triangles, spheres, 1);
 }
 
 /* Traverses the packet: as one frustum when packet_frustum allows, else
@@ -236,7 +258,9 @@ __attribute__((noinline)) int bvh_packet_traverse(const TracePacket* p, PacketHi
                                                    global const TriangleBlock* triangles,
                                                    global const SphereBlock* spheres) {
   PacketFrustum frustum;
-  if (packet_frustum(p, &frustum)) return bvh_frustum_traverse(p, &frustum, h, nodes, triangles, spheres);
+  if (packet_frustum(p, &frustum))
+    return frustum.loose ? bvh_frustum_traverse_loose(p, &frustum, h, nodes, triangles, spheres)
+                         : bvh_frustum_traverse_tight(p, &frustum, h, nodes, triangles, spheres);
   float8 stack_t[RTCL_STACK_SIZE]; /* entry distances of stack_ref's box, NaN: ray not in it */
   int stack_ref[RTCL_STACK_SIZE];
   float stack_key[RTCL_STACK_SIZE]; /* nearest entry distance over the packet: visiting order */
