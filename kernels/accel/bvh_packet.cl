@@ -90,6 +90,14 @@ typedef struct PacketFrustum {
 inline float packet_min(float8 v, int8 lanes) { return rtcl_min8_ordered(select((float8)(INFINITY), v, lanes)); }
 inline float packet_max(float8 v, int8 lanes) { return rtcl_max8_ordered(select((float8)(-INFINITY), v, lanes)); }
 
+/* The range of v over `lanes`: max into *first and min into *second when
+ * high_first, else the other way round. */
+inline void packet_range(float8 v, int8 lanes, int high_first, float* first, float* second) {
+  float lo = packet_min(v, lanes), hi = packet_max(v, lanes);
+  *first = high_first ? hi : lo;
+  *second = high_first ? lo : hi;
+}
+
 /* Fills *f and returns 1 when the packet's active rays share a direction
  * octant, have finite reciprocals and tmin >= 0, else returns 0. */
 inline int packet_frustum(const TracePacket* p, PacketFrustum* f) {
@@ -100,27 +108,15 @@ inline int packet_frustum(const TracePacket* p, PacketFrustum* f) {
   if ((pos_x && rtcl_any8(a & ~p->pos_x)) || (pos_y && rtcl_any8(a & ~p->pos_y)) ||
       (pos_z && rtcl_any8(a & ~p->pos_z)))
     return 0;
-  float ox_lo = packet_min(p->ox, a), ox_hi = packet_max(p->ox, a);
-  float oy_lo = packet_min(p->oy, a), oy_hi = packet_max(p->oy, a);
-  float oz_lo = packet_min(p->oz, a), oz_hi = packet_max(p->oz, a);
-  f->onx = pos_x ? ox_hi : ox_lo;
-  f->ofx = pos_x ? ox_lo : ox_hi;
-  f->ony = pos_y ? oy_hi : oy_lo;
-  f->ofy = pos_y ? oy_lo : oy_hi;
-  f->onz = pos_z ? oz_hi : oz_lo;
-  f->ofz = pos_z ? oz_lo : oz_hi;
+  packet_range(p->ox, a, pos_x, &f->onx, &f->ofx);
+  packet_range(p->oy, a, pos_y, &f->ony, &f->ofy);
+  packet_range(p->oz, a, pos_z, &f->onz, &f->ofz);
   f->tmin = packet_min(p->tmin, a);
   if (!(f->tmin >= 0.0f)) return 0;
-  f->loose = ox_lo != ox_hi || oy_lo != oy_hi || oz_lo != oz_hi;
-  float lx = packet_min(p->ix, a), hx = packet_max(p->ix, a);
-  float ly = packet_min(p->iy, a), hy = packet_max(p->iy, a);
-  float lz = packet_min(p->iz, a), hz = packet_max(p->iz, a);
-  f->rnx = pos_x ? lx : hx;
-  f->rfx = pos_x ? hx : lx;
-  f->rny = pos_y ? ly : hy;
-  f->rfy = pos_y ? hy : ly;
-  f->rnz = pos_z ? lz : hz;
-  f->rfz = pos_z ? hz : lz;
+  f->loose = f->onx != f->ofx || f->ony != f->ofy || f->onz != f->ofz;
+  packet_range(p->ix, a, !pos_x, &f->rnx, &f->rfx);
+  packet_range(p->iy, a, !pos_y, &f->rny, &f->rfy);
+  packet_range(p->iz, a, !pos_z, &f->rnz, &f->rfz);
   f->near_x = pos_x ? 0 : 3;
   f->near_y = pos_y ? 1 : 4;
   f->near_z = pos_z ? 2 : 5;
