@@ -35,8 +35,9 @@
 // all three), AB_MORTON_ORDER (set: every timed set traced, by every
 // version and Embree, in the host's Morton order of render/ray_order.hpp
 // instead of the camera's row order), AB_PACKET_TILES (set: the primary
-// rays in rtcl bench's packet-tile order, render/ray_order.hpp's
-// packet_tile_order, instead of row order), AB_REPEAT_RAYS (N in 1 .. 1024: every
+// rays, and so the shadow and diffuse rays spawned from them, in rtcl
+// bench's packet-tile order, render/ray_order.hpp's packet_tile_order,
+// instead of row order), AB_REPEAT_RAYS (N in 1 .. 1024: every
 // timed set's rays replaced by every N-th ray, each traced N times in a row,
 // by every version and Embree: the same count of rays, whose caches and
 // branch history then see each path N times), RTCL_BENCH_RES,

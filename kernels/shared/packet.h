@@ -26,8 +26,9 @@ typedef struct TracePacket {
   float8 dx, dy, dz;
   float8 tmax;
   int8 active;
-  /* every lane's permutation is (axis_x, axis_y, axis_z) (-1: they differ):
-   * the triangle tests then pick each vertex coordinate once per packet */
+  /* every lane's permutation is (axis_x, axis_y, axis_z), or axis_x = -1
+   * where they differ: the triangle tests then pick each vertex coordinate
+   * once per packet */
   int axis_x, axis_y, axis_z;
 } TracePacket;
 

@@ -33,7 +33,7 @@ constexpr std::uint32_t kSubtreeRef = 0x80000000u;
 // The split search, the binning and the partition are compiled twice, for
 // AVX2 and for the baseline x86-64, and the loader picks by the CPU (GCC's
 // target_clones, an ifunc), as Embree picks its builders by ISA: the
-// three-operand VEX forms and blends of AVX2 took 5-7% off the small
+// three-operand VEX forms and blends of AVX2 took 3-11% off the small
 // scenes' builds (README "The BVH against Embree on the Zen 5 host"). AVX2
 // does not include FMA, so no contraction: the same arithmetic, and the
 // same tree, on every x86-64 CPU. Left out with sanitizers and elsewhere.
