@@ -25,17 +25,16 @@ struct Subtree {
 
 }  // namespace
 
-CollapsePlan plan_collapse(const BuildTree& tree, const Geometry& geometry) {
+void plan_subtree(const BuildTree& tree, const Geometry& geometry, std::uint32_t root, CollapsePlan& plan) {
   const std::size_t n = tree.nodes.size();
   auto fail = [&](const std::string& what) { throw Error("internal: BVH over " + geometry.source + ": " + what); };
-  CollapsePlan plan;
-  plan.split_.assign(n, {});
-  plan.wide_.assign(n, 0);
-  if (n == 0) return plan;
-  std::vector<std::uint8_t> seen(n, 0);
+  auto claim = [&](std::uint32_t m) {
+    if (m >= n) fail("child " + std::to_string(m) + " does not exist");
+    if (plan.seen_[m].exchange(1, std::memory_order_relaxed)) fail("node " + std::to_string(m) + " is reached twice");
+  };
+  claim(root);
   std::vector<Subtree> done;  // finished subtrees, a left one below its sibling
-  std::vector<std::pair<std::uint32_t, bool>> todo{{0, false}};  // node, its children finished
-  seen[0] = 1;
+  std::vector<std::pair<std::uint32_t, bool>> todo{{root, false}};  // node, its children finished
   while (!todo.empty()) {
     const auto [m, children_done] = todo.back();
     const BuildNode& b = tree.nodes[m];
@@ -43,8 +42,7 @@ CollapsePlan plan_collapse(const BuildTree& tree, const Geometry& geometry) {
       todo.back().second = true;
       for (int side = 1; side >= 0; --side) {  // the left child on top: finished first
         const std::uint32_t c = b.child[side];
-        if (c >= n) fail("child " + std::to_string(c) + " does not exist");
-        if (seen[c]++) fail("node " + std::to_string(c) + " is reached twice");
+        claim(c);
         todo.push_back({c, false});
       }
       continue;
@@ -97,6 +95,11 @@ CollapsePlan plan_collapse(const BuildTree& tree, const Geometry& geometry) {
     }
     done.push_back(s);
   }
+}
+
+CollapsePlan plan_collapse(const BuildTree& tree, const Geometry& geometry) {
+  CollapsePlan plan(tree.nodes.size());
+  if (!tree.nodes.empty()) plan_subtree(tree, geometry, 0, plan);
   return plan;
 }
 

@@ -16,6 +16,8 @@
 #pragma once
 
 #include <array>
+#include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -32,6 +34,10 @@ inline constexpr float kCollapseNodeCost = 0.5f;
 
 class CollapsePlan {
  public:
+  // Room for the plan of a tree of `nodes` binary nodes, none planned yet
+  // (plan_subtree fills it).
+  explicit CollapsePlan(std::size_t nodes = 0) : split_(nodes), wide_(nodes), seen_(nodes) {}
+
   // Slots for binary node m's children when m's subtree may take `budget`
   // (1..8) children: {left, right}, both >= 1; {0, 0}: m is one child.
   std::pair<int, int> split(std::uint32_t m, int budget) const {
@@ -45,15 +51,23 @@ class CollapsePlan {
   std::pair<int, int> wide_split(std::uint32_t m) const { return {wide_[m] & 15, wide_[m] >> 4}; }
 
  private:
-  friend CollapsePlan plan_collapse(const BuildTree& tree, const Geometry& geometry);
+  friend void plan_subtree(const BuildTree& tree, const Geometry& geometry, std::uint32_t root, CollapsePlan& plan);
   // Per node: [0] is_block; [i - 1] for budget i >= 2: left | right << 4.
   std::vector<std::array<std::uint8_t, 8>> split_;
   std::vector<std::uint8_t> wide_;  // left | right << 4
+  // Nodes planned, each claimed by one plan_subtree call: a node reached
+  // twice, in one subtree or in two, is an error, never planned twice.
+  std::vector<std::atomic<std::uint8_t>> seen_;
 };
 
-// The plan of `tree`, whose leaves index geometry's primitives (triangles,
-// then spheres). Throws Error when a child does not exist or a node is
-// reached twice (the flatten checks the rest).
+// Plans the subtree of binary node `root` of `tree`, whose leaves index
+// geometry's primitives (triangles, then spheres), into plan (made for
+// tree's nodes). Disjoint subtrees may be planned on several threads at
+// once. Throws Error when a child does not exist or a node is reached twice
+// (the flatten checks the rest).
+void plan_subtree(const BuildTree& tree, const Geometry& geometry, std::uint32_t root, CollapsePlan& plan);
+
+// The plan of the whole tree (plan_subtree from the root).
 CollapsePlan plan_collapse(const BuildTree& tree, const Geometry& geometry);
 
 }  // namespace rtcl
