@@ -170,6 +170,34 @@ TEST(BvhCollapse, RejectsMalformedTrees) {
   EXPECT_THROW(flatten_bvh8(shared, g), Error);
 }
 
+// A tree large enough to be walked in parts, each part planning its own
+// subtree on whichever thread is free: a cycle inside a part, and a node
+// shared by two parts, are errors on any number of threads.
+TEST(BvhCollapse, RejectsMalformedTreesWalkedInParts) {
+  const Geometry g = random_soup(20000, 11);
+  const BuildTree tree = build_binary_bvh(g);
+  ASSERT_GE(tree.nodes.size(), 4096u);
+  // two inner nodes five levels down, in different subtrees of the root
+  auto descend = [&](std::uint32_t n, int side) {
+    for (int level = 0; level < 5; ++level) {
+      EXPECT_FALSE(tree.nodes[n].is_leaf());
+      n = tree.nodes[n].child[level == 0 ? side : 0];
+    }
+    return n;
+  };
+  const std::uint32_t a = descend(0, 0), b = descend(0, 1);
+  ASSERT_FALSE(tree.nodes[a].is_leaf());
+  ASSERT_FALSE(tree.nodes[b].is_leaf());
+  BuildTree cycle = tree;
+  cycle.nodes[a].child[1] = tree.nodes[0].child[0];
+  BuildTree shared = tree;
+  shared.nodes[b].child[1] = tree.nodes[a].child[1];
+  for (unsigned threads : {1u, 2u, 4u}) {
+    EXPECT_THROW(flatten_bvh8(cycle, g, {.thread_count = threads}), Error) << threads << " threads";
+    EXPECT_THROW(flatten_bvh8(shared, g, {.thread_count = threads}), Error) << threads << " threads";
+  }
+}
+
 TEST(BvhCollapse, GreedyLevelsIsAnOption) {
   Geometry g = random_soup(2000, 10);
   auto planned = make_accel(test_device(), "bvh:greedy_levels=0", g);

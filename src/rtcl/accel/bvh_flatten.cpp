@@ -12,7 +12,9 @@
 //    kSplitDepth - 1 wide levels first, then each subtree below them on
 //    whichever thread is free, each part's nodes and blocks placed after the
 //    top's in the order the top met them, so that the result does not depend on
-//    the threads.
+//    the threads. When the top levels are greedy (the default), each part
+//    plans its own subtree before walking it; otherwise the whole tree is
+//    planned first.
 // 2. Gather (block ranges on parallel threads): each block is filled from the
 //    geometry, every primitive's vertices read once and checked there: inside
 //    its binary leaf's box, not a zero-area triangle, not marked before by
