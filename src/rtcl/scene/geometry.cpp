@@ -43,17 +43,6 @@ Aabb Geometry::bounds() const {
   return b;
 }
 
-bool zero_area(const Geometry& g, std::size_t triangle) {
-  const glm::uvec3& t = g.triangles[triangle];
-  return zero_area(g.vertices[t.x], g.vertices[t.y], g.vertices[t.z]);
-}
-
-bool zero_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
-  glm::dvec3 da(a), db(b), dc(c);
-  glm::dvec3 n = glm::cross(db - da, dc - da);
-  return n.x == 0.0 && n.y == 0.0 && n.z == 0.0;
-}
-
 namespace {
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
