@@ -3,6 +3,8 @@
 #include <pthread.h>
 
 
+#include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <exception>
@@ -21,14 +23,17 @@ namespace {
 struct Batch {
   const std::function<void(unsigned)>* job;
   unsigned count;
-  unsigned next;     // the next job to claim
-  unsigned running;  // jobs not yet returned, job 0 included
+  unsigned next;                  // the next job to claim
+  std::atomic<unsigned> running;  // jobs not yet returned, job 0 included (changed under the mutex)
   std::vector<std::exception_ptr> errors;
   std::condition_variable finished;
 };
 
 class ThreadPool;
 ThreadPool* the_pool = nullptr;  // for the fork handlers
+// Jobs the calling thread is running (nested run_jobs calls count once in
+// ThreadPool::active_).
+thread_local unsigned jobs_on_this_thread = 0;
 
 class ThreadPool {
  public:
@@ -61,6 +66,7 @@ class ThreadPool {
       std::lock_guard<std::mutex> lock(mutex_);
       queue_.push_back(&batch);
       unclaimed_ += jobs - 1;
+      unclaimed_now_.store(unclaimed_, std::memory_order_relaxed);
       // every waiting job has an idle thread to take it at once
       while (idle_ < unclaimed_) {
         ++idle_;
@@ -71,7 +77,15 @@ class ThreadPool {
       work_.notify_all();
     else
       work_.notify_one();
+    const bool outermost = jobs_on_this_thread == 0;
+    if (outermost) active_.fetch_add(1, std::memory_order_relaxed);
+    ++jobs_on_this_thread;
     execute(batch, 0);
+    spin_until([&] { return batch.running.load(std::memory_order_relaxed) == 0; });
+    --jobs_on_this_thread;
+    if (outermost) active_.fetch_sub(1, std::memory_order_relaxed);
+    // the mutex, taken after the last job's release of it, before the batch
+    // goes out of scope
     std::unique_lock<std::mutex> lock(mutex_);
     batch.finished.wait(lock, [&] { return batch.running == 0; });
     lock.unlock();
@@ -95,15 +109,27 @@ class ThreadPool {
   void serve() {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
+      if (!stopping_ && queue_.empty()) {
+        lock.unlock();
+        if (active_.fetch_add(1, std::memory_order_relaxed) < cores_)
+          spin_until([&] { return unclaimed_now_.load(std::memory_order_relaxed) > 0; });
+        active_.fetch_sub(1, std::memory_order_relaxed);
+        lock.lock();
+      }
       work_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
       if (queue_.empty()) return;
       Batch& batch = *queue_.front();
       const unsigned k = batch.next++;
       if (batch.next == batch.count) queue_.pop_front();
       --unclaimed_;
+      unclaimed_now_.store(unclaimed_, std::memory_order_relaxed);
       --idle_;
       lock.unlock();
+      active_.fetch_add(1, std::memory_order_relaxed);
+      jobs_on_this_thread = 1;
       execute(batch, k);
+      jobs_on_this_thread = 0;
+      active_.fetch_sub(1, std::memory_order_relaxed);
       lock.lock();
       ++idle_;
     }
@@ -116,12 +142,21 @@ class ThreadPool {
     threads_.clear();
     queue_.clear();
     unclaimed_ = idle_ = 0;
+    unclaimed_now_.store(0, std::memory_order_relaxed);
+    active_.store(0, std::memory_order_relaxed);
   }
 
   std::mutex mutex_;
   std::condition_variable work_;  // a job is waiting, or the pool stops
   std::deque<Batch*> queue_;      // batches with unclaimed jobs, oldest first
   unsigned unclaimed_ = 0;        // jobs in queue_'s batches not yet claimed
+  std::atomic<unsigned> unclaimed_now_{0};  // unclaimed_, for spinning threads (written under the mutex)
+  // Threads running jobs (callers and pool threads) or spinning for one: a
+  // pool thread spins only while fewer than cores_ are (a spinning thread
+  // must not take a core from one with work). Signed: a fork inside a job
+  // starts the child at 0.
+  std::atomic<int> active_{0};
+  const int cores_ = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   unsigned idle_ = 0;             // pool threads not running a job
   bool stopping_ = false;
   std::vector<std::thread> threads_;
