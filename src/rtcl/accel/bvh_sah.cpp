@@ -1,6 +1,7 @@
 #include "rtcl/accel/bvh_sah.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <condition_variable>
@@ -185,7 +186,11 @@ class SahBuilder {
   BuildTree run() {
     BuildTree tree;
     if (ref_count_ == 0) return tree;
-    tasks_.push_back({new_subtree(ref_count_), root_, 1});
+    const std::uint32_t root_subtree = new_subtree(ref_count_);
+    if (thread_count_ > 1 && ref_count_ >= kParallelBinMin)
+      build(*subtrees_[root_subtree], 0, root_, 1, Children::as_tasks);
+    else
+      add_task({root_subtree, root_, 1});
     run_jobs(thread_count_, [this](unsigned) { work(); });
     assemble(tree.nodes);
     reserve_advised(tree.prims, ref_count_);
@@ -448,10 +453,21 @@ class SahBuilder {
     return mid;
   }
 
+  // A subtree waiting for a thread.
+  struct Task {
+    std::uint32_t subtree;  // index in subtrees_
+    Range range;
+    std::uint32_t depth;
+  };
+
   // Builds the subtree of range into nodes[node] and new nodes appended to
   // nodes; a child of at least parallel_min_primitives references becomes a
   // subtree of its own on the task list when more than one thread builds.
-  void build(std::vector<BuildNode>& nodes, std::uint32_t node, const Range& range, std::uint32_t depth) {
+  // With Children::as_tasks (the root, split before the threads take tasks)
+  // both children become tasks, and build returns.
+  enum class Children { built, as_tasks };
+  void build(std::vector<BuildNode>& nodes, std::uint32_t node, const Range& range, std::uint32_t depth,
+             Children children = Children::built) {
     const std::uint32_t n = range.end - range.begin;
     const bool root = n == ref_count_;
     const float area = range.bounds.area();
@@ -490,28 +506,43 @@ class SahBuilder {
     const bool left_smaller = left.end - left.begin < right.end - right.begin;
     const Range& small = left_smaller ? left : right;
     const Range& large = left_smaller ? right : left;
-    const bool hand_off = thread_count_ > 1 && small.end - small.begin >= config_.parallel_min_primitives;
+    const bool as_tasks = children == Children::as_tasks;
+    const bool hand_off =
+        as_tasks || (thread_count_ > 1 && small.end - small.begin >= config_.parallel_min_primitives);
+    auto task_ref = [&](const Range& child) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const std::uint32_t subtree = new_subtree(child.end - child.begin);
+      add_task({subtree, child, depth + 1});
+      return kSubtreeRef | subtree;
+    };
     std::uint32_t small_ref;
     if (hand_off) {
-      {
-        std::lock_guard<std::mutex> lock(mutex_);
-        const std::uint32_t subtree = new_subtree(small.end - small.begin);
-        tasks_.push_back({subtree, small, depth + 1});
-        small_ref = kSubtreeRef | subtree;
-      }
+      small_ref = task_ref(small);
       ready_.notify_one();
     } else {
       small_ref = static_cast<std::uint32_t>(nodes.size());
       nodes.emplace_back();
     }
-    const auto large_ref = static_cast<std::uint32_t>(nodes.size());
-    nodes.emplace_back();
+    std::uint32_t large_ref;
+    if (as_tasks) {
+      large_ref = task_ref(large);
+    } else {
+      large_ref = static_cast<std::uint32_t>(nodes.size());
+      nodes.emplace_back();
+    }
     BuildNode& inner = nodes[node];
     inner.bounds = range.bounds.aabb();
     inner.child[0] = left_smaller ? small_ref : large_ref;
     inner.child[1] = left_smaller ? large_ref : small_ref;
+    if (as_tasks) return;
     if (!hand_off) build(nodes, small_ref, small, depth + 1);
     build(nodes, large_ref, large, depth + 1);
+  }
+
+  // Adds a task (the mutex held, or before the threads start).
+  void add_task(const Task& task) {
+    tasks_.push_back(task);
+    task_count_.store(tasks_.size(), std::memory_order_relaxed);
   }
 
   // One thread of the build: takes subtrees from tasks_ (the largest first)
@@ -519,6 +550,13 @@ class SahBuilder {
   void work() {
     std::unique_lock<std::mutex> lock(mutex_);
     for (;;) {
+      if (tasks_.empty() && busy_threads_ > 0) {
+        lock.unlock();
+        spin_until([&] {
+          return task_count_.load(std::memory_order_relaxed) != 0 || busy_threads_.load(std::memory_order_relaxed) == 0;
+        });
+        lock.lock();
+      }
       ready_.wait(lock, [&] { return !tasks_.empty() || busy_threads_ == 0; });
       if (tasks_.empty()) {
         ready_.notify_all();
@@ -529,6 +567,7 @@ class SahBuilder {
       });
       Task task = *largest;
       tasks_.erase(largest);
+      task_count_.store(tasks_.size(), std::memory_order_relaxed);
       std::vector<BuildNode>* nodes = subtrees_[task.subtree].get();
       ++busy_threads_;
       lock.unlock();
@@ -571,12 +610,6 @@ class SahBuilder {
     });
   }
 
-  struct Task {
-    std::uint32_t subtree;  // index in subtrees_
-    Range range;
-    std::uint32_t depth;
-  };
-
   const SahConfig& config_;
   std::unique_ptr<SahRef[]> refs_;
   std::size_t ref_count_;
@@ -591,7 +624,8 @@ class SahBuilder {
   std::mutex mutex_;
   std::condition_variable ready_;
   std::vector<Task> tasks_;     // subtrees waiting for a thread
-  int busy_threads_ = 0;        // threads building a task (guarded by mutex_)
+  std::atomic<std::size_t> task_count_{0};  // tasks_.size(), read without the mutex
+  std::atomic<int> busy_threads_{0};        // threads building a task (changed under mutex_)
 };
 
 }  // namespace
