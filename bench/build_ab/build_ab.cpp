@@ -22,7 +22,11 @@
 // of its own row, all in every round, the order rotated;
 // AB_THREADS: the host threads of both builders (default every hardware
 // thread; rtcl's validate always uses them all), e.g. 1 to compare the
-// builders' serial work.
+// builders' serial work; AB_GAP_MS: the pause before each build (default
+// 20): longer than rtcl's threads spin once out of work (1 ms; TBB's
+// workers spin too), so that neither builder's idle threads run into the
+// other's timed build, and each build starts with its threads asleep, as a
+// program's one build does.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -103,6 +107,13 @@ int run(int argc, char** argv) {
       throw Error(std::string("AB_THREADS: '") + threads_env + "' is not a count of 1..1024");
     threads = static_cast<unsigned>(value);
   }
+  std::chrono::milliseconds gap{20};
+  if (const char* gap_env = std::getenv("AB_GAP_MS"); gap_env && *gap_env) {
+    char* end = nullptr;
+    const long value = std::strtol(gap_env, &end, 10);
+    if (*end || value < 0 || value > 10000) throw Error(std::string("AB_GAP_MS: '") + gap_env + "' is not 0..10000 ms");
+    gap = std::chrono::milliseconds(value);
+  }
   std::vector<BvhConfig> configs;  // AB_BVH's builds, SAH on `threads`
   std::vector<std::string> labels;
   const char* bvh_env = std::getenv("AB_BVH");
@@ -135,6 +146,7 @@ int run(int argc, char** argv) {
     const std::size_t versions = configs.size() + 1;  // the last one is Embree
     for (int round = 0; round < rounds; ++round)
       for (std::size_t j = 0; j < versions; ++j) {
+        std::this_thread::sleep_for(gap);
         const std::size_t v = (j + static_cast<std::size_t>(round)) % versions;
         if (v == configs.size()) {
           theirs.push_back(embree_build_ms(geometry, threads));
