@@ -5,10 +5,11 @@
 //
 // A thread that runs out of work spins for kSpinTime before it sleeps. On
 // the development VM, waking a sleeping thread took 25-100 us per loop (an
-// empty two-job run_jobs: 26 us back to back, 68 us 0.2 ms apart), and
-// after the build's threads had slept, one sibenik build on 2 threads took
-// 1.3-1.7x as long as one right after another; spinning between the loops
-// made the two the same (README "Build levers").
+// empty two-job run_jobs, median: 25 us back to back, 56 us 0.2 ms apart;
+// 2 and 9 us with the spin), and after the build's threads had slept 20 ms,
+// one sibenik build on 2 threads took 1.6-1.7x as long as one right after
+// another; with the spin (and the SAH builder's root split before its
+// tasks) the two are within 5% (README "Build levers").
 #pragma once
 
 #include <chrono>
