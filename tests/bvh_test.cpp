@@ -454,10 +454,11 @@ TEST(Bvh, SahBuilderNamesTheFirstBadBoxOnEveryThread) {
     }
 }
 
-// build_binary_bvh fills the SAH builder's references in its own pass over
-// the triangles (zero-area ones skipped in every part): the tree of the
-// stored triangles' boxes and ids given to build_sah, and of the same
-// references given to it, on one thread and on two.
+// build_binary_bvh fills the SAH builder's references and gathers their
+// bounds in its own pass over the triangles (zero-area ones skipped in
+// every part): the tree of the stored triangles' boxes and ids given to
+// build_sah, and of the same references given to it with and without their
+// bounds, on one thread and on two.
 TEST(Bvh, SahOverFilledReferencesBuildsTheTreeOfTheBoxes) {
   Geometry g = random_soup(40000, 31);
   for (std::size_t i = 3; i < g.triangles.size(); i += 7) g.triangles[i].z = g.triangles[i].y;
@@ -470,7 +471,13 @@ TEST(Bvh, SahOverFilledReferencesBuildsTheTreeOfTheBoxes) {
     canonical(build_sah(in.bounds, in.ids, config.sah), 0, of_boxes);
     auto refs = std::make_unique<SahRef[]>(in.ids.size());
     for (std::size_t i = 0; i < in.ids.size(); ++i) refs[i] = SahRef::of(in.bounds[i], in.ids[i]);
+    auto bounded_refs = std::make_unique<SahRef[]>(in.ids.size());
+    SahBounds bounds;
+    for (std::size_t i = 0; i < in.ids.size(); ++i) bounds.add(bounded_refs[i] = refs[i]);
     canonical(build_sah(std::move(refs), in.ids.size(), config.sah), 0, of_refs);
+    std::vector<double> of_bounded_refs;
+    canonical(build_sah(std::move(bounded_refs), in.ids.size(), bounds, config.sah), 0, of_bounded_refs);
+    EXPECT_TRUE(of_bounded_refs == of_boxes) << threads << " threads, references with their bounds";
     std::size_t stored = 0;
     canonical(build_binary_bvh(g, config, &stored), 0, of_geometry);
     EXPECT_EQ(stored, in.ids.size());

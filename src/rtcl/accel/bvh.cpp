@@ -25,15 +25,20 @@ Aabb sphere_bounds(const Sphere& s) {
   return {s.center - r, s.center + r};
 }
 
-// Calls write(k, i, box) for the k-th triangle i of non-zero area (k from
-// 0 up) and its box, on the build's threads, and returns how many there
-// are: each part writes from its own first triangle on, then
-// move(from, count, to) moves each later part down over the gaps its
-// predecessors' zero-area triangles left.
+// The parts for_each_kept_triangle splits the triangles into.
+unsigned kept_triangle_parts(const Geometry& geometry, unsigned threads) {
+  return part_count(geometry.triangles.size(), threads, kBoundsPartMin);
+}
+
+// Calls write(part, k, i, box) for the k-th triangle i of non-zero area (k
+// from 0 up) and its box, on the build's threads, kept_triangle_parts
+// parts, and returns how many there are: each part writes from its own
+// first triangle on, then move(from, count, to) moves each later part down
+// over the gaps its predecessors' zero-area triangles left.
 template <class Write, class Move>
 std::size_t for_each_kept_triangle(const Geometry& geometry, unsigned threads, Write write, Move move) {
   const std::size_t triangles = geometry.triangles.size();
-  const unsigned parts = part_count(triangles, threads, kBoundsPartMin);
+  const unsigned parts = kept_triangle_parts(geometry, threads);
   std::vector<std::size_t> part_end(parts);
   for_each_part(triangles, parts, [&](unsigned part, std::size_t begin, std::size_t end) {
     std::size_t out = begin;
@@ -41,7 +46,8 @@ std::size_t for_each_kept_triangle(const Geometry& geometry, unsigned threads, W
       const glm::uvec3& t = geometry.triangles[i];
       const glm::vec3 &a = geometry.vertices[t.x], &b = geometry.vertices[t.y], &c = geometry.vertices[t.z];
       if (zero_area(a, b, c)) continue;
-      write(out++, static_cast<std::uint32_t>(i), Aabb{glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))});
+      write(part, out++, static_cast<std::uint32_t>(i),
+            Aabb{glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))});
     }
     part_end[part] = out;
   });
@@ -108,15 +114,25 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config, st
   };
   if (!config.custom_builder && config.builder == BvhBuilder::sah && config.presplit <= 0.0f) {
     // The SAH builder's own array filled here, without box and id arrays
-    // in between (README, "The SAH builder's input").
+    // in between, and the references' bounds gathered in the same pass
+    // (README, "The SAH builder's input").
     auto refs = std::make_unique_for_overwrite<SahRef[]>(triangles);
     advise_huge_pages(refs.get(), triangles * sizeof(SahRef));
+    struct alignas(64) PartBounds {  // a cache line each: the parts write theirs on their threads
+      SahBounds bounds;
+    };
+    std::vector<PartBounds> part_bounds(kept_triangle_parts(geometry, bvh_thread_count(config)));
     const std::size_t kept = for_each_kept_triangle(
         geometry, bvh_thread_count(config),
-        [&](std::size_t k, std::uint32_t i, const Aabb& box) { refs[k] = SahRef::of(box, i); },
+        [&](unsigned part, std::size_t k, std::uint32_t i, const Aabb& box) {
+          refs[k] = SahRef::of(box, i);
+          part_bounds[part].bounds.add(refs[k]);
+        },
         [&](std::size_t from, std::size_t n, std::size_t to) { std::copy_n(refs.get() + from, n, refs.get() + to); });
     count_stored(kept);
-    BuildTree triangle_tree = kept ? build_sah(std::move(refs), kept, config.sah) : BuildTree{};
+    SahBounds bounds;
+    for (const PartBounds& b : part_bounds) bounds.add(b.bounds);
+    BuildTree triangle_tree = kept ? build_sah(std::move(refs), kept, bounds, config.sah) : BuildTree{};
     return join(std::move(triangle_tree), build_kind(sphere_boxes, sphere_ids, config));
   }
   // The stored primitives (stored_primitives' ids, triangles first) and
@@ -125,7 +141,7 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config, st
   std::vector<Aabb> bounds(triangles);
   const std::size_t kept = for_each_kept_triangle(
       geometry, bvh_thread_count(config),
-      [&](std::size_t k, std::uint32_t i, const Aabb& box) {
+      [&](unsigned, std::size_t k, std::uint32_t i, const Aabb& box) {
         ids[k] = i;
         bounds[k] = box;
       },

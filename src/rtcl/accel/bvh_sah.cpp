@@ -182,6 +182,15 @@ class SahBuilder {
   // Over refs the caller filled; tested as above.
   SahBuilder(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahConfig& config)
       : SahBuilder(std::move(refs), count, config, Filled{}) {}
+  // Over refs the caller filled, tested and bounded (build_sah's contract).
+  SahBuilder(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahBounds& bounds, const SahConfig& config)
+      : config_(config), refs_(std::move(refs)), ref_count_(count) {
+    thread_count_ = thread_count(config, count);
+    auto box = [](const Aabb& b) {
+      return Box{Float4{b.lower.x, b.lower.y, b.lower.z, 0.0f}, Float4{b.upper.x, b.upper.y, b.upper.z, 0.0f}};
+    };
+    root_ = {0, static_cast<std::uint32_t>(count), box(bounds.boxes), box(bounds.centres)};
+  }
 
   BuildTree run() {
     BuildTree tree;
@@ -210,8 +219,7 @@ class SahBuilder {
   template <class RefOf>
   SahBuilder(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahConfig& config, RefOf ref_of)
       : config_(config), refs_(std::move(refs)), ref_count_(count) {
-    thread_count_ = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
-    if (ref_count_ < 2 * config.parallel_min_primitives) thread_count_ = 1;
+    thread_count_ = thread_count(config, count);
     const unsigned parts = part_count(ref_count_, thread_count_, config.parallel_min_primitives);
     std::vector<Range> part_ranges(parts);
     for_each_part(ref_count_, parts, [&](unsigned part, std::size_t begin, std::size_t end) {
@@ -238,6 +246,13 @@ class SahBuilder {
       root_.bounds.grow(r.bounds);
       root_.centres.grow(r.centres);
     }
+  }
+
+  // The threads that build count references: config's (0 = every hardware
+  // thread), one below two tasks' worth.
+  static unsigned thread_count(const SahConfig& config, std::size_t count) {
+    if (count < 2 * config.parallel_min_primitives) return 1;
+    return config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
   }
 
   // Best SAH plane over bins of the centroids in the range. Nodes use n / 8
@@ -643,6 +658,11 @@ void check_config(const SahConfig& config) {
     throw Error("SAH builder: max_sah_depth " + std::to_string(config.max_sah_depth) + " is above 1024");
 }
 
+void check_refs(const std::unique_ptr<SahRef[]>& refs, std::size_t count) {
+  if (count > 0x7fffffffu) throw Error("SAH builder: " + std::to_string(count) + " primitives exceed 2^31 - 1");
+  if (count > 0 && !refs) throw Error("SAH builder: " + std::to_string(count) + " references and no array");
+}
+
 }  // namespace
 
 BuildTree build_sah(std::span<const Aabb> bounds, std::span<const std::uint32_t> ids, const SahConfig& config) {
@@ -653,9 +673,15 @@ BuildTree build_sah(std::span<const Aabb> bounds, std::span<const std::uint32_t>
 
 BuildTree build_sah(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahConfig& config) {
   check_config(config);
-  if (count > 0x7fffffffu) throw Error("SAH builder: " + std::to_string(count) + " primitives exceed 2^31 - 1");
-  if (count > 0 && !refs) throw Error("SAH builder: " + std::to_string(count) + " references and no array");
+  check_refs(refs, count);
   return SahBuilder(std::move(refs), count, config).run();
+}
+
+BuildTree build_sah(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahBounds& bounds,
+                    const SahConfig& config) {
+  check_config(config);
+  check_refs(refs, count);
+  return SahBuilder(std::move(refs), count, bounds, config).run();
 }
 
 }  // namespace rtcl

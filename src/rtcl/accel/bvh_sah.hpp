@@ -73,4 +73,32 @@ struct alignas(16) SahRef {
 // array; the same tree as from the boxes and ids, the same errors.
 BuildTree build_sah(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahConfig& config = {});
 
+// The union of references' boxes and that of their centres (0.5 lower +
+// 0.5 upper per axis, the builder's arithmetic), gathered by a caller that
+// fills the references.
+struct SahBounds {
+  Aabb boxes, centres;
+
+  void add(const SahRef& r) {
+    for (int a = 0; a < 3; ++a) {
+      const float centre = 0.5f * r.lower[a] + 0.5f * r.upper[a];
+      boxes.lower[a] = r.lower[a] < boxes.lower[a] ? r.lower[a] : boxes.lower[a];
+      boxes.upper[a] = boxes.upper[a] < r.upper[a] ? r.upper[a] : boxes.upper[a];
+      centres.lower[a] = centre < centres.lower[a] ? centre : centres.lower[a];
+      centres.upper[a] = centres.upper[a] < centre ? centre : centres.upper[a];
+    }
+  }
+  void add(const SahBounds& b) {
+    boxes.grow(b.boxes);
+    centres.grow(b.centres);
+  }
+};
+
+// As above, over refs whose boxes the caller knows to be valid (finite,
+// lower <= upper: a triangle's of validated vertices) and whose bounds it
+// gathered while filling them: the builder skips its own pass over them.
+// The same tree.
+BuildTree build_sah(std::unique_ptr<SahRef[]> refs, std::size_t count, const SahBounds& bounds,
+                    const SahConfig& config = {});
+
 }  // namespace rtcl
