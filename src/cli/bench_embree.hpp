@@ -25,8 +25,9 @@ class EmbreeBaseline {
  public:
   // Builds Embree's scene of the geometry's triangles and spheres (its default, medium
   // quality build on `threads` threads; `robust`: with
-  // RTC_SCENE_FLAG_ROBUST, Embree's watertight mode).
-  EmbreeBaseline(const Geometry& geometry, unsigned threads, bool robust);
+  // RTC_SCENE_FLAG_ROBUST, Embree's watertight mode) `builds` times, each
+  // after kBuildPause, and keeps the last.
+  EmbreeBaseline(const Geometry& geometry, unsigned threads, bool robust, int builds);
   ~EmbreeBaseline();
   EmbreeBaseline(const EmbreeBaseline&) = delete;
   EmbreeBaseline& operator=(const EmbreeBaseline&) = delete;
@@ -35,8 +36,9 @@ class EmbreeBaseline {
   bool has_packets() const;
 
   // One warm-up trace, then `repeat` timed ones of `rays`, single rays or
-  // packets of rays 8k .. 8k + 7; fills the baseline's figures (not its
-  // check) and returns the answers of the last trace.
+  // packets of rays 8k .. 8k + 7; fills the baseline's figures (the
+  // builds' among them, not its check) and returns the answers of the last
+  // trace.
   std::vector<Hit> measure(Query query, bool packets, const std::vector<Ray>& rays, int repeat,
                            BenchBaseline& out) const;
 
@@ -50,6 +52,7 @@ class EmbreeBaseline {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   unsigned threads_;
+  std::vector<double> build_ms_runs_;
 };
 
 }  // namespace rtcl::cli

@@ -58,6 +58,7 @@ json baseline_json(const BenchBaseline& b) {
           {"threads", b.threads},
           {"ray_count", b.ray_count},
           {"build_ms", b.build_ms},
+          {"build_ms_runs", b.build_ms_runs},
           {"bytes", b.bytes},
           {"trace_ms", spread_json(trace)},
           {"wall_ms", spread_json(wall)},
@@ -80,6 +81,7 @@ json cell_json(const BenchCell& c, const BenchBaseline* baseline) {
       {"query", c.query},
       {"ray_count", c.ray_count},
       {"build_ms", c.build_ms},
+      {"build_ms_runs", c.build_ms_runs},
       {"setup_ms", c.setup_ms},
       {"first_launch_ms", c.first_launch_ms},
       {"packets", c.packets},
@@ -168,7 +170,9 @@ std::string bench_markdown(const BenchRun& run) {
                    " threads, " + std::to_string(run.size) + "x" + std::to_string(run.size) +
                    " rays per primary set, median (min - max) Mrays/s of " + std::to_string(run.repeat) +
                    " kernel launches after a warm-up (OpenCL event times), precision " + run.precision +
-                   "; build: host ms; B/prim: device bytes per primitive; check: rays agreeing with brute force" +
+                   "; build: host ms, median of " + std::to_string(run.repeat) + " builds, each after a " +
+                   std::to_string(kBuildPause.count()) +
+                   " ms pause; B/prim: device bytes per primitive; check: rays agreeing with brute force" +
                    (run.diffuse_sort != "never"
                         ? "; diffuse rays traced as scattered calls, sorted on the device " +
                               std::string(run.diffuse_sort == "always" ? "always"

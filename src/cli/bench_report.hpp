@@ -3,6 +3,7 @@
 // merge) and bench.md (one table per device). Schema: README, "rtcl bench".
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -15,12 +16,19 @@ struct Spread {
 };
 Spread spread_of(std::vector<double> values);  // all 0 for no values
 
+// The pause before each timed build of `rtcl bench` (a structure's and
+// Embree's): longer than the threads of the step before (PoCL's, TBB's,
+// rtcl's own) spin once out of work, so that none runs into the build, and
+// every build starts with its threads asleep, as a program's one build does.
+inline constexpr std::chrono::milliseconds kBuildPause{20};
+
 struct BenchCell {
   std::size_t device = 0;  // index into BenchRun::devices
   std::string scene, accel, rays, query;  // rays: primary | shadow | diffuse; query: closest | any
   std::string precision;                  // fast | robust | exact
   std::size_t ray_count = 0;
-  double build_ms = 0.0;       // host build (AccelStats::build_ms)
+  double build_ms = 0.0;       // host build (AccelStats::build_ms): the median of build_ms_runs
+  std::vector<double> build_ms_runs;  // each build of the structure, after kBuildPause
   // make_accel's wall time less build_ms: the upload and the closest-hit
   // program's build. Programs are cached per process and device, so a
   // structure's first cell carries the build (the BVH's: rays_ms of the
@@ -57,7 +65,8 @@ struct BenchBaseline {
   bool packets = false;
   unsigned threads = 0;
   std::size_t ray_count = 0;
-  double build_ms = 0.0;   // rtcCommitScene and geometry setup, wall
+  double build_ms = 0.0;   // rtcCommitScene and geometry setup, wall: the median of build_ms_runs
+  std::vector<double> build_ms_runs;  // each build of the scene, after kBuildPause
   std::size_t bytes = 0;   // Embree's memory after the build (its memory monitor)
   std::vector<double> trace_ms, wall_ms;  // per timed trace: the traversal alone; with the ray and answer conversions
   std::size_t checked = 0, disagreeing = 0;
