@@ -91,6 +91,9 @@ TEST(CliBench, SmokeRunWritesACompleteMatrix) {
     ASSERT_TRUE(cell["embree"].is_object()) << cell.dump();
     EXPECT_EQ(cell["embree"]["api"], api);
     EXPECT_GT(cell["embree"]["ratio"].get<double>(), 0.0) << cell.dump();
+    // a build of Embree's after each of the structure's
+    EXPECT_EQ(cell["embree"]["build_ms_runs"].size(), 2u);
+    EXPECT_GT(cell["embree"]["build_ratio"].get<double>(), 0.0) << cell.dump();
     EXPECT_GT(cell["embree"]["mrays_per_s"]["median"].get<double>(), 0.0);
     // Embree traced the cell's rays after each of its launches
     EXPECT_TRUE(cell["embree"]["paired"].get<bool>());

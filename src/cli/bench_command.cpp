@@ -311,10 +311,11 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
   AccelConfig config;
   config.precision = matrix.precision;
   config.scattered_sort = matrix.diffuse_sort;
-  // `repeat` builds, each after kBuildPause; the cells trace the last one.
-  // setup: the first's (its program builds).
+  // `repeat` builds, each after kBuildPause and each followed by one of
+  // Embree's (after its own pause); the cells trace the last one. setup:
+  // the first's (its program builds).
   std::unique_ptr<Accel> accel;
-  std::vector<double> build_ms_runs;
+  std::vector<double> build_ms_runs, embree_build_ms_runs;
   double setup = 0.0;
   for (int b = 0; b < repeat; ++b) {
     accel.reset();
@@ -323,6 +324,10 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
     accel = make_accel(device, accel_name, scene.scene.geometry, config);
     if (b == 0) setup = ms_since(start) - accel->stats().build_ms;
     build_ms_runs.push_back(accel->stats().build_ms);
+    if (embree) {
+      std::this_thread::sleep_for(kBuildPause);
+      embree_build_ms_runs.push_back(embree->build_once_ms());
+    }
   }
   const AccelStats& stats = accel->stats();
   std::vector<BenchCell> cells;
@@ -336,6 +341,7 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
     cell.query = kind_query(k) == Query::any ? "any" : "closest";
     cell.build_ms = spread_of(build_ms_runs).median;
     cell.build_ms_runs = build_ms_runs;
+    cell.embree_build_ms_runs = embree_build_ms_runs;
     cell.setup_ms = std::max(0.0, setup);
     cell.device_bytes = stats.device_bytes;
     cell.primitives = stats.primitive_count;

@@ -27,7 +27,7 @@ struct EmbreeBaseline::Impl {
 std::string embree_baseline_version(unsigned threads) { return bench::embree_version(threads); }
 
 EmbreeBaseline::EmbreeBaseline(const Geometry& geometry, unsigned threads, bool robust, int builds)
-    : threads_(threads) {
+    : geometry_(&geometry), threads_(threads), robust_(robust) {
   for (int b = 0; b < builds; ++b) {
     impl_.reset();
     std::this_thread::sleep_for(kBuildPause);
@@ -38,6 +38,10 @@ EmbreeBaseline::EmbreeBaseline(const Geometry& geometry, unsigned threads, bool 
 }
 
 bool EmbreeBaseline::has_packets() const { return bench::embree_has_packet8(threads_); }
+
+double EmbreeBaseline::build_once_ms() const {
+  return bench::EmbreeScene(*geometry_, bench::EmbreeQuality::standard, threads_, robust_).build_ms();
+}
 
 std::vector<Hit> EmbreeBaseline::measure(Query query, bool packets, const std::vector<Ray>& rays, int repeat,
                                          BenchBaseline& out) const {
@@ -77,11 +81,14 @@ struct EmbreeBaseline::Impl {};
 
 std::string embree_baseline_version(unsigned) { return ""; }
 
-EmbreeBaseline::EmbreeBaseline(const Geometry&, unsigned threads, bool, int) : threads_(threads) {
+EmbreeBaseline::EmbreeBaseline(const Geometry& geometry, unsigned threads, bool robust, int)
+    : geometry_(&geometry), threads_(threads), robust_(robust) {
   throw Error("rtcl was built without Embree: no Embree baseline");
 }
 
 bool EmbreeBaseline::has_packets() const { return false; }
+
+double EmbreeBaseline::build_once_ms() const { return 0.0; }
 
 std::vector<Hit> EmbreeBaseline::measure(Query, bool, const std::vector<Ray>&, int, BenchBaseline&) const {
   return {};

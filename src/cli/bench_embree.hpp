@@ -35,6 +35,10 @@ class EmbreeBaseline {
   // Whether Embree traces 8-ray packets natively here (rtcIntersect8 is then measured too).
   bool has_packets() const;
 
+  // One more build of the scene, as the constructor's, released at once:
+  // its ms (`rtcl bench` pairs one with each build of a structure).
+  double build_once_ms() const;
+
   // One warm-up trace, then `repeat` timed ones of `rays`, single rays or
   // packets of rays 8k .. 8k + 7; fills the baseline's figures (the
   // builds' among them, not its check) and returns the answers of the last
@@ -51,7 +55,9 @@ class EmbreeBaseline {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  const Geometry* geometry_;
   unsigned threads_;
+  bool robust_;
   std::vector<double> build_ms_runs_;
 };
 

@@ -35,6 +35,13 @@ Spread embree_rate(const BenchCell& c, const BenchBaseline& b) {
                                     : rate_of(c.ray_count, spread_of(c.embree_paired_ms));
 }
 
+// The cell's build against Embree's builds paired with it: the ratio of the
+// medians (rtcl / Embree: below 1, rtcl builds faster); 0 without them.
+double build_ratio(const BenchCell& c) {
+  const double embree = spread_of(c.embree_build_ms_runs).median;
+  return embree > 0.0 ? c.build_ms / embree : 0.0;
+}
+
 // The cell against its Embree baseline: Embree's traversal rate and the
 // ratio of the medians (rtcl kernel rate / Embree traversal rate).
 json embree_json(const BenchCell& c, const BenchBaseline* b) {
@@ -46,7 +53,9 @@ json embree_json(const BenchCell& c, const BenchBaseline* b) {
           {"paired", !c.embree_paired_ms.empty()},
           {"trace_ms_runs", c.embree_paired_ms.empty() ? b->trace_ms : c.embree_paired_ms},
           {"mrays_per_s", spread_json(embree)},
-          {"ratio", embree.median > 0.0 ? rtcl.median / embree.median : 0.0}};
+          {"ratio", embree.median > 0.0 ? rtcl.median / embree.median : 0.0},
+          {"build_ms_runs", c.embree_build_ms_runs},
+          {"build_ratio", build_ratio(c)}};
 }
 
 json baseline_json(const BenchBaseline& b) {
@@ -184,7 +193,8 @@ std::string bench_markdown(const BenchRun& run) {
                         : "; xE: ratio to Embree " + run.embree_version +
                               (run.embree_flags == "robust" ? " (RTC_SCENE_FLAG_ROBUST)" : " (default flags)") +
                               " on the same rays (its traversal time on the host threads; packet kernels against "
-                              "rtcIntersect8 / rtcOccluded8).\n");
+                              "rtcIntersect8 / rtcOccluded8), and for the build to its default build, each paired "
+                              "with one of the structure's.\n");
   for (std::size_t d = 0; d < run.devices.size(); ++d) {
     const BenchDevice& device = run.devices[d];
     md += "\n### [" + std::to_string(device.index) + "] " + device.name + " (" + device.platform + ", driver " +
@@ -225,8 +235,10 @@ std::string bench_markdown(const BenchRun& run) {
         double per_prim = first->primitives ? static_cast<double>(first->device_bytes) /
                                                   static_cast<double>(first->primitives)
                                             : 0.0;
-        md += "| " + scene + " | " + accel + " |" + format(" %.1f |", first->build_ms) +
-              format(" %.1f |", per_prim) + row + " " + check + " |\n";
+        std::string build = format(" %.1f", first->build_ms);
+        if (build_ratio(*first) > 0.0) build += format(" x%.2fE", build_ratio(*first));
+        md += "| " + scene + " | " + accel + " |" + build + " |" + format(" %.1f |", per_prim) + row + " " + check +
+              " |\n";
       }
   }
   if (!run.embree.empty()) {

@@ -29,6 +29,10 @@ struct BenchCell {
   std::size_t ray_count = 0;
   double build_ms = 0.0;       // host build (AccelStats::build_ms): the median of build_ms_runs
   std::vector<double> build_ms_runs;  // each build of the structure, after kBuildPause
+  // Embree's build of the scene right after each of those (after its own
+  // pause), when the run has the baseline: the build ratio is taken from
+  // these, as a trace ratio from embree_paired_ms.
+  std::vector<double> embree_build_ms_runs;
   // make_accel's wall time less build_ms: the upload and the closest-hit
   // program's build. Programs are cached per process and device, so a
   // structure's first cell carries the build (the BVH's: rays_ms of the
