@@ -9,7 +9,7 @@
 // 2 and 9 us with the spin), and after the build's threads had slept 20 ms,
 // one sibenik build on 2 threads took 1.6-1.7x as long as one right after
 // another; with the spin (and the SAH builder's root split before its
-// tasks) the two are within 5% (README "Build threads that stay awake").
+// tasks) the two are within 10% (README "Build threads that stay awake").
 #pragma once
 
 #include <chrono>
