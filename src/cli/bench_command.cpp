@@ -311,13 +311,13 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
   AccelConfig config;
   config.precision = matrix.precision;
   config.scattered_sort = matrix.diffuse_sort;
-  // `repeat` builds, each after kBuildPause and each followed by one of
-  // Embree's (after its own pause); the cells trace the last one. setup:
-  // the first's (its program builds).
+  // build_count(repeat) builds, each after kBuildPause and each followed by
+  // one of Embree's (after its own pause); the cells trace the last one.
+  // setup: the first's (its program builds).
   std::unique_ptr<Accel> accel;
   std::vector<double> build_ms_runs, embree_build_ms_runs;
   double setup = 0.0;
-  for (int b = 0; b < repeat; ++b) {
+  for (int b = 0; b < build_count(repeat); ++b) {
     accel.reset();
     std::this_thread::sleep_for(kBuildPause);
     Clock::time_point start = Clock::now();
@@ -418,7 +418,7 @@ void run_bench(const BenchOptions& options) {
     if (!run.embree_version.empty()) {
       progress(done, total, scene_spec.text + " / Embree " + run.embree_version);
       embree = std::make_unique<EmbreeBaseline>(scene.scene.geometry, options.embree_threads, options.embree_robust,
-                                                options.repeat);
+                                                build_count(options.repeat));
       for (BenchBaseline& b : bench_embree(*embree, scene, matrix.kinds, options.repeat))
         run.embree.push_back(std::move(b));
       ++done;
@@ -455,7 +455,8 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--size", options->size, "image side in pixels: size x size primary rays")
       ->check(CLI::Range(1, 16384))
       ->capture_default_str();
-  cmd->add_option("--repeat", options->repeat, "timed launches per cell, after one warm-up launch")
+  cmd->add_option("--repeat", options->repeat,
+                  "timed launches per cell, after one warm-up launch; builds per structure and scene (at most 9)")
       ->check(CLI::Range(1, 10000))
       ->capture_default_str();
   cmd->add_option("--check-rays", options->check_rays,

@@ -179,7 +179,7 @@ std::string bench_markdown(const BenchRun& run) {
                    " threads, " + std::to_string(run.size) + "x" + std::to_string(run.size) +
                    " rays per primary set, median (min - max) Mrays/s of " + std::to_string(run.repeat) +
                    " kernel launches after a warm-up (OpenCL event times), precision " + run.precision +
-                   "; build: host ms, median of " + std::to_string(run.repeat) + " builds, each after a " +
+                   "; build: host ms, median of " + std::to_string(build_count(run.repeat)) + " builds, each after a " +
                    std::to_string(kBuildPause.count()) +
                    " ms pause; B/prim: device bytes per primitive; check: rays agreeing with brute force" +
                    (run.diffuse_sort != "never"

@@ -21,6 +21,10 @@ Spread spread_of(std::vector<double> values);  // all 0 for no values
 // rtcl's own) spin once out of work, so that none runs into the build, and
 // every build starts with its threads asleep, as a program's one build does.
 inline constexpr std::chrono::milliseconds kBuildPause{20};
+// Builds per structure and scene: --repeat, up to this many (a build of
+// millions of triangles takes a second, a trace launch milliseconds).
+inline constexpr int kMaxBuilds = 9;
+inline int build_count(int repeat) { return repeat < kMaxBuilds ? repeat : kMaxBuilds; }
 
 struct BenchCell {
   std::size_t device = 0;  // index into BenchRun::devices
