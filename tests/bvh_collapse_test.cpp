@@ -177,9 +177,11 @@ TEST(BvhCollapse, RejectsMalformedTreesWalkedInParts) {
   const Geometry g = random_soup(20000, 11);
   const BuildTree tree = build_binary_bvh(g);
   ASSERT_GE(tree.nodes.size(), 4096u);
-  // two inner nodes five levels down, in different subtrees of the root
+  // two inner nodes eight levels down, in different subtrees of the root,
+  // below the top walk (with the plan's claim disabled the cycle hangs the
+  // plan: five levels down, the top walk had caught both)
   auto descend = [&](std::uint32_t n, int side) {
-    for (int level = 0; level < 5; ++level) {
+    for (int level = 0; level < 8; ++level) {
       EXPECT_FALSE(tree.nodes[n].is_leaf());
       n = tree.nodes[n].child[level == 0 ? side : 0];
     }
