@@ -80,13 +80,9 @@ struct SahBounds {
   Aabb boxes, centres;
 
   void add(const SahRef& r) {
-    for (int a = 0; a < 3; ++a) {
-      const float centre = 0.5f * r.lower[a] + 0.5f * r.upper[a];
-      boxes.lower[a] = r.lower[a] < boxes.lower[a] ? r.lower[a] : boxes.lower[a];
-      boxes.upper[a] = boxes.upper[a] < r.upper[a] ? r.upper[a] : boxes.upper[a];
-      centres.lower[a] = centre < centres.lower[a] ? centre : centres.lower[a];
-      centres.upper[a] = centres.upper[a] < centre ? centre : centres.upper[a];
-    }
+    const glm::vec3 lower(r.lower[0], r.lower[1], r.lower[2]), upper(r.upper[0], r.upper[1], r.upper[2]);
+    boxes.grow(Aabb{lower, upper});
+    centres.grow(0.5f * lower + 0.5f * upper);
   }
   void add(const SahBounds& b) {
     boxes.grow(b.boxes);
