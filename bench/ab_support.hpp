@@ -5,9 +5,9 @@
 #pragma once
 
 #include "rtcl/bench/scene_catalog.hpp"
-#include "rtcl/cl/opencl.hpp"
+#include "rtcl/opencl.hpp"
 #include "rtcl/error.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "rtcl/scene/procedural.hpp"
 

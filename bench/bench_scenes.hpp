@@ -12,11 +12,11 @@
 
 #include <glm/glm.hpp>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/bench/scene_catalog.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/layouts.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl::bench {
 

@@ -1,4 +1,4 @@
-// The speed/accuracy trade of the precision levels (src/rtcl/accel/precision.hpp):
+// The speed/accuracy trade of the precision levels (src/rtcl/precision.hpp):
 //   precision/<scene>/<level>/<accel>    primary rays of a bench scene: Mrays/s (kernel time of one
 //                                        launch) and, on every k-th ray (at most $RTCL_BENCH_PRECISION_RAYS,
 //                                        default 2048), the errors against the double-precision reference
@@ -24,7 +24,7 @@
 
 #include "bench_scenes.hpp"
 #include "ray_sets.hpp"
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/scene/default_scene.hpp"
 #include "support/closed_meshes.hpp"

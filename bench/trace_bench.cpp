@@ -23,7 +23,7 @@
 #include <utility>
 
 #include "bench_scenes.hpp"
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 
 namespace rtcl::bench {
 namespace {

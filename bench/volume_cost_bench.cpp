@@ -11,7 +11,7 @@
 
 #include "bench_scenes.hpp"
 #include "rtcl/accel/bvh.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 
 namespace rtcl::bench {
 namespace {

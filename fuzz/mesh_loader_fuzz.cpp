@@ -11,7 +11,7 @@
 
 #include "fuzz_files.hpp"
 #include "rtcl/error.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

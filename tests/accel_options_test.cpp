@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/grid.hpp"
 #include "rtcl/error.hpp"

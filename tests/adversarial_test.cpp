@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "support/closed_meshes.hpp"
 #include "support/error_of.hpp"
 #include "support/everywhere.hpp"

@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "rtcl/bounds/aabb.hpp"
+#include "rtcl/aabb.hpp"
 #include "rtcl/bounds/obb.hpp"
 #include "support/point_clouds.hpp"
 

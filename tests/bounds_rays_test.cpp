@@ -18,7 +18,7 @@
 #include "rtcl/bounds/point_input.hpp"
 #include "rtcl/bounds/sphere_bounds.hpp"
 #include "rtcl/bounds/volume_rays.hpp"
-#include "rtcl/cl/opencl.hpp"
+#include "rtcl/opencl.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"

@@ -8,7 +8,7 @@
 #include <limits>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/bvh_collapse.hpp"
 #include "rtcl/error.hpp"

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/render/ray_order.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "support/fixtures.hpp"

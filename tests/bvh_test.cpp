@@ -9,6 +9,7 @@
 #include <random>
 
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "support/fixtures.hpp"

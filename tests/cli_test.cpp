@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rtcl/io/ray_file.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"

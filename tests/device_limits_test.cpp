@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
-#include "rtcl/cl/opencl.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/opencl.hpp"
 #include "rtcl/io/ray_file.hpp"
 #include "support/cli_run.hpp"
 #include "support/error_of.hpp"

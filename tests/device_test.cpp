@@ -1,4 +1,4 @@
-// The device layer (src/rtcl/cl/device.hpp) and the buffer checks of
+// The device layer (src/rtcl/device.hpp) and the buffer checks of
 // Accel::trace: discovery, selection, adoption of a caller's context, build
 // errors, the program cache, and errors that name what the user passed.
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 
 #include <unistd.h>
 
-#include "rtcl/accel/accel.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/cl/program.hpp"
 #include "rtcl/error.hpp"
 #include "support/error_of.hpp"

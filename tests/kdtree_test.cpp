@@ -15,6 +15,7 @@
 #include <random>
 
 #include "rtcl/accel/brute.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/accel/bsp.hpp"
 #include "rtcl/accel/kdtree.hpp"
 #include "rtcl/accel/kdtree_fused.hpp"

@@ -1,4 +1,4 @@
-// The precision levels (src/rtcl/accel/precision.hpp) at the extremes, for
+// The precision levels (src/rtcl/precision.hpp) at the extremes, for
 // every structure in accel_names(): the exact level against a
 // double-precision reference that decides ties, the tie rule, degenerate
 // geometry and extreme ray records at every level (tests/support/everywhere.hpp),
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "support/closed_meshes.hpp"

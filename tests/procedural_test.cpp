@@ -12,7 +12,7 @@
 #include <string>
 #include <utility>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/brute.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/procedural.hpp"

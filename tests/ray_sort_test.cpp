@@ -14,7 +14,7 @@
 #include <random>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/ray_sort.hpp"
 #include "support/fixtures.hpp"
 

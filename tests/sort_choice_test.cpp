@@ -6,7 +6,7 @@
 #include <memory>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/sort_choice.hpp"
 #include "support/fixtures.hpp"
 

@@ -37,11 +37,11 @@
 #include <vector>
 
 #include "rtcl/accel/bvh.hpp"
-#include "rtcl/accel/options.hpp"
+#include "rtcl/accel_options.hpp"
 #include "rtcl/bench/embree_baseline.hpp"
 #include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/error.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 #include "rtcl/scene/procedural.hpp"
 
 #include "../ab_support.hpp"

@@ -25,13 +25,13 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/bench/ray_sets.hpp"
 #include "rtcl/bench/scene_catalog.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/render/ray_order.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 #include "../ab_support.hpp"
 

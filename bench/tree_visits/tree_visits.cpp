@@ -25,13 +25,13 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/bvh.hpp"
-#include "rtcl/accel/options.hpp"
-#include "rtcl/bounds/aabb.hpp"
+#include "rtcl/accel_options.hpp"
+#include "rtcl/aabb.hpp"
 #include "rtcl/bench/ray_sets.hpp"
 #include "rtcl/bench/scene_catalog.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
 
 #include "../ab_support.hpp"

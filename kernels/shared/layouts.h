@@ -5,33 +5,11 @@
 #ifndef RTCL_SHARED_LAYOUTS_H
 #define RTCL_SHARED_LAYOUTS_H
 
-#ifdef __OPENCL_VERSION__
-typedef int rtcl_i32;
-typedef uint rtcl_u32;
-#else
-#include <cstdint>
+#include "query_layouts.h"
+
+#ifndef __OPENCL_VERSION__
 namespace rtcl {
-typedef std::int32_t rtcl_i32;
-typedef std::uint32_t rtcl_u32;
 #endif
-
-/* A ray: 32 bytes, 4-byte aligned, identical to one record of the ray file.
- * Valid hits have tmin <= t <= tmax. The direction need not be unit length;
- * t is measured in units of |dir|. */
-typedef struct Ray {
-  float ox, oy, oz;
-  float dx, dy, dz;
-  float tmin, tmax;
-} Ray;
-
-/* A query result: 16 bytes, 4-byte aligned, identical to one hit-file record.
- * Miss: t = +inf, prim = -1, u = v = 0. For a triangle (v0, v1, v2) the hit
- * point is (1-u-v)*v0 + u*v1 + v*v2; for a sphere u = v = 0.
- * prim: triangle ids come first (0 .. triangle_count-1), then spheres. */
-typedef struct Hit {
-  float t, u, v;
-  rtcl_i32 prim;
-} Hit;
 
 /* Leaves hold up to RTCL_BLOCK_WIDTH primitives in SoA form, so that one
  * work-item tests all of them with float8 arithmetic. */

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 
 namespace rtcl::cli {
 

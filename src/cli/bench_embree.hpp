@@ -12,9 +12,9 @@
 #include <vector>
 
 #include "bench_report.hpp"
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/layouts.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl::cli {
 

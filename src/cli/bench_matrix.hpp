@@ -13,9 +13,9 @@
 #include "bench_embree.hpp"
 #include "bench_report.hpp"
 #include "bench_scenes.hpp"
-#include "rtcl/accel/precision.hpp"
+#include "rtcl/precision.hpp"
 #include "rtcl/accel/sort_choice.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 
 namespace rtcl::cli {
 

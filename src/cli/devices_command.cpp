@@ -4,8 +4,8 @@
 #include <string>
 
 #include "commands.hpp"
-#include "rtcl/accel/precision.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/precision.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl::cli {

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/scene/scene.hpp"
 

@@ -1,11 +1,11 @@
 // `rtcl structures`: every acceleration structure with its build options,
 // their types, defaults, ranges and trade-offs (the registry's declarations,
-// rtcl/accel/options.hpp).
+// rtcl/accel_options.hpp).
 #include <cstdio>
 #include <string>
 
 #include "commands.hpp"
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 
 namespace rtcl::cli {
 

@@ -12,8 +12,8 @@
 
 #include "accel_option.hpp"
 #include "commands.hpp"
-#include "rtcl/accel/accel.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/io/atomic_file.hpp"
 #include "rtcl/io/ray_file.hpp"

@@ -11,6 +11,8 @@ static_assert(offsetof(Ray, ox) == 0 && offsetof(Ray, dx) == 12 && offsetof(Ray,
               offsetof(Ray, tmax) == 28);
 static_assert(sizeof(Hit) == 16 && alignof(Hit) == 4);
 static_assert(offsetof(Hit, t) == 0 && offsetof(Hit, u) == 4 && offsetof(Hit, v) == 8 && offsetof(Hit, prim) == 12);
+static_assert(sizeof(PointHit) == 32 && alignof(PointHit) == 4);
+static_assert(offsetof(PointHit, distance) == 12 && offsetof(PointHit, u) == 16 && offsetof(PointHit, prim) == 24);
 static_assert(sizeof(TriangleBlock) == 320 && offsetof(TriangleBlock, prim) == 288);
 static_assert(sizeof(SphereBlock) == 160 && offsetof(SphereBlock, r) == 96 && offsetof(SphereBlock, prim) == 128);
 static_assert(sizeof(Bvh8Node) == 224 && offsetof(Bvh8Node, child) == 192);

@@ -2,11 +2,11 @@
 // and uses rtcl as its ray-tracing backend: it adopts its context and queue,
 // builds a structure over its own arrays, and traces rays from its own cl_mem
 // buffers into its own cl_mem buffers. Exits 0 when the answers are right.
-#include <rtcl/accel/accel.hpp>
-#include <rtcl/cl/device.hpp>
+#include <rtcl/accel.hpp>
+#include <rtcl/device.hpp>
 #include <rtcl/error.hpp>
 #include <rtcl/layouts.hpp>
-#include <rtcl/scene/geometry.hpp>
+#include <rtcl/geometry.hpp>
 
 #include <algorithm>
 #include <cmath>

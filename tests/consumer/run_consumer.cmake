@@ -21,8 +21,8 @@ set(build "${WORK_DIR}/build")
 file(REMOVE_RECURSE "${WORK_DIR}")
 
 run("install" "${CMAKE_COMMAND}" --install "${RTCL_BUILD_DIR}" --prefix "${prefix}")
-foreach(file include/rtcl/shared/layouts.h include/rtcl/layouts.hpp include/rtcl/accel/accel.hpp
-             include/rtcl/cl/device.hpp include/rtcl/cl/opencl.hpp include/rtcl/scene/geometry.hpp
+foreach(file include/rtcl/shared/layouts.h include/rtcl/layouts.hpp include/rtcl/accel.hpp
+             include/rtcl/device.hpp include/rtcl/opencl.hpp include/rtcl/geometry.hpp
              include/rtcl/error.hpp ${RTCL_LIBDIR}/cmake/rtcl/rtclConfig.cmake
              ${RTCL_LIBDIR}/cmake/rtcl/rtclConfigVersion.cmake ${RTCL_LIBDIR}/cmake/rtcl/rtclTargets.cmake)
   if(NOT EXISTS "${prefix}/${file}")

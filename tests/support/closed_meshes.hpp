@@ -9,7 +9,7 @@
 
 #include <glm/glm.hpp>
 
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl::test {
 

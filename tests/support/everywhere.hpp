@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/layouts.hpp"
 
 namespace rtcl::test::everywhere {

@@ -6,10 +6,10 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/layouts.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl::test {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/kdtree_nodes.hpp"
 
 namespace rtcl::test {

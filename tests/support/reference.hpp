@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/layouts.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl::test {
 

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 
 namespace rtcl::cli {
 

@@ -1,5 +1,7 @@
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 
+#include "rtcl/accel/accel_state.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/layouts.hpp"
 
 namespace rtcl {
@@ -22,28 +24,36 @@ Accel::Accel(const Device& device, std::string name, TraceKernels incoherent, st
       stats_(stats),
       precision_(config.precision),
       defines_(with_precision(device.info(), std::move(defines), config.precision)),
-      incoherent_{std::move(incoherent), {}, {}},
-      sort_choices_{SortChoice(config.scattered_sort), SortChoice(config.scattered_sort)} {
-  if (coherent) coherent_ = KernelSet{std::move(*coherent), {}, {}};
-  const TraceKernels& single = incoherent_.spec;
+      state_(std::make_unique<State>(std::move(incoherent), config.scattered_sort)) {
+  State& st = *state_;
+  if (coherent) st.coherent = State::KernelSet{std::move(*coherent), {}, {}};
+  const TraceKernels& single = st.incoherent.spec;
   if (single.rays_per_work_item == 1 && single.sortable && device.info().type == "cpu" &&
       config.scattered_sort != ScatteredSort::never)
-    scattered_ = KernelSet{single, {}, {}, true};
-  kernel_for(incoherent_, Query::closest);
+    st.scattered = State::KernelSet{single, {}, {}, true};
+  std::lock_guard lock(st.mutex);
+  st.kernel_for(st.incoherent, Query::closest, device_, defines_);
 }
 
-Accel::KernelSet& Accel::set_for(Coherence coherence) const {
-  if (coherence == Coherence::coherent && coherent_) return *coherent_;
-  if (coherence == Coherence::scattered && scattered_) return *scattered_;
-  return incoherent_;
+Accel::~Accel() = default;
+
+Accel::State::KernelSet& Accel::State::set_for(Coherence coherence) {
+  if (coherence == Coherence::coherent && coherent) return *coherent;
+  if (coherence == Coherence::scattered && scattered) return *scattered;
+  return incoherent;
 }
 
-bool Accel::sorts(Coherence coherence) const { return set_for(coherence).ordered; }
+bool Accel::sorts(Coherence coherence) const { return state_->set_for(coherence).ordered; }
 
-Accel::QueryKernel& Accel::kernel_for(KernelSet& set, Query query) const {
+bool Accel::last_call_sorted() const { return state_->last_sorted; }
+
+const cl::Event& Accel::first_event() const { return state_->first_event; }
+
+Accel::State::QueryKernel& Accel::State::kernel_for(KernelSet& set, Query query, const Device& device_,
+                                                    const std::vector<std::string>& structure_defines) {
   std::optional<QueryKernel>& slot = query == Query::closest ? set.closest : set.any;
   if (slot) return *slot;
-  std::vector<std::string> defines = defines_;
+  std::vector<std::string> defines = structure_defines;
   defines.push_back(query == Query::closest ? "RTCL_QUERY_CLOSEST" : "RTCL_QUERY_ANY");
   if (set.ordered) defines.push_back("RTCL_TRACE_ORDER");
   cl::Program program = device_.program(set.spec.file, defines);
@@ -54,27 +64,29 @@ Accel::QueryKernel& Accel::kernel_for(KernelSet& set, Query query) const {
   return *slot;
 }
 
-bool Accel::sort_this_call(Coherence coherence, Query query) const {
-  if (coherence != Coherence::scattered || !scattered_) return false;
+bool Accel::State::sort_this_call(Coherence coherence, Query query) {
+  if (coherence != Coherence::scattered || !scattered) return false;
   record_pending(query);
-  return sort_choices_[query == Query::closest ? 0 : 1].next();
+  return sort_choices[query == Query::closest ? 0 : 1].next();
 }
 
 bool Accel::sort_choice_settled(Query query) const {
-  if (!scattered_) return true;
-  record_pending(query);
-  return sort_choices_[query == Query::closest ? 0 : 1].settled();
+  State& st = *state_;
+  std::lock_guard lock(st.mutex);
+  if (!st.scattered) return true;
+  st.record_pending(query);
+  return st.sort_choices[query == Query::closest ? 0 : 1].settled();
 }
 
-void Accel::record_pending(Query query) const {
+void Accel::State::record_pending(Query query) {
   std::size_t q = query == Query::closest ? 0 : 1;
-  if (std::optional<PendingCall>& pending = pending_[q]) {
+  if (std::optional<PendingCall>& pending = this->pending[q]) {
     cl_int status = pending->done.getInfo<CL_EVENT_COMMAND_EXECUTION_STATUS>();
     if (status == CL_COMPLETE) {
       double ms = static_cast<double>(pending->done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
                                       pending->first.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
                   1e-6;
-      sort_choices_[q].record(pending->sorted, ms / static_cast<double>(pending->ray_count));
+      sort_choices[q].record(pending->sorted, ms / static_cast<double>(pending->ray_count));
       pending.reset();
     } else if (status < 0) {
       pending.reset();  // failed: nothing to learn from it
@@ -82,12 +94,21 @@ void Accel::record_pending(Query query) const {
   }
 }
 
-std::size_t Accel::rays_per_work_item(Coherence coherence) const { return set_for(coherence).spec.rays_per_work_item; }
+std::size_t Accel::rays_per_work_item(Coherence coherence) const {
+  return state_->set_for(coherence).spec.rays_per_work_item;
+}
 
-std::size_t Accel::occluder_run(Coherence coherence) const { return set_for(coherence).spec.occluder_run; }
+std::size_t Accel::occluder_run(Coherence coherence) const { return state_->set_for(coherence).spec.occluder_run; }
 
 cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hits, std::size_t ray_count,
                        const std::vector<cl::Event>& wait, Coherence coherence) const {
+  std::lock_guard lock(state_->mutex);
+  return trace_locked(query, rays, hits, ray_count, wait, coherence);
+}
+
+cl::Event Accel::trace_locked(Query query, const cl::Buffer& rays, const cl::Buffer& hits, std::size_t ray_count,
+                              const std::vector<cl::Event>& wait, Coherence coherence) const {
+  State& st = *state_;
   return with_cl_errors([&] {
     if (ray_count > 0xffffffffu) throw Error(name_ + " trace: ray_count " + std::to_string(ray_count) + " exceeds 2^32-1");
     std::size_t ray_bytes = rays.getInfo<CL_MEM_SIZE>(), hit_bytes = hits.getInfo<CL_MEM_SIZE>();
@@ -97,10 +118,11 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     if (hit_bytes < ray_count * sizeof(Hit))
       throw Error(name_ + " trace: hit buffer holds " + std::to_string(hit_bytes / sizeof(Hit)) + " hits, " +
                   std::to_string(ray_count) + " requested");
-    bool sorted = ray_count > 0 && sort_this_call(coherence, query);
-    KernelSet& set = sorted ? *scattered_ : set_for(coherence == Coherence::scattered ? Coherence::incoherent : coherence);
-    QueryKernel& slot = kernel_for(set, query);
-    last_sorted_ = sorted;
+    bool sorted = ray_count > 0 && st.sort_this_call(coherence, query);
+    State::KernelSet& set =
+        sorted ? *st.scattered : st.set_for(coherence == Coherence::scattered ? Coherence::incoherent : coherence);
+    State::QueryKernel& slot = st.kernel_for(set, query, device_, defines_);
+    st.last_sorted = sorted;
     if (!slot.args_set) {
       set_structure_args(slot.kernel, set.ordered ? 4 : 3);
       slot.args_set = true;
@@ -113,16 +135,16 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     cl::Event done;
     if (ray_count == 0) {
       device_.queue().enqueueMarkerWithWaitList(&wait, &done);
-      first_event_ = done;
+      st.first_event = done;
       return done;
     }
     std::vector<cl::Event> before = wait;
     if (set.ordered) {
-      if (!sort_) sort_ = std::make_unique<RaySort>(device_, stats_.bounds);
-      std::vector<cl::Event> passes = sort_->enqueue(rays, ray_count, wait);
-      kernel.setArg(3, sort_->order());
+      if (!st.sort) st.sort = std::make_unique<RaySort>(device_, stats_.bounds);
+      std::vector<cl::Event> passes = st.sort->enqueue(rays, ray_count, wait);
+      kernel.setArg(3, st.sort->order());
       before = {passes.back()};
-      first_event_ = passes.front();
+      st.first_event = passes.front();
     }
     // A fixed work-group size (global rounded up; the kernels check ray_count):
     // PoCL generates code per local size, and left to choose (NULL) it picks
@@ -136,10 +158,10 @@ cl::Event Accel::trace(Query query, const cl::Buffer& rays, const cl::Buffer& hi
     device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
                                          fixed ? cl::NDRange(group) : cl::NullRange,
                                          before.empty() ? nullptr : &before, &done);
-    if (!set.ordered) first_event_ = done;
+    if (!set.ordered) st.first_event = done;
     std::size_t q = query == Query::closest ? 0 : 1;
-    if (coherence == Coherence::scattered && scattered_ && device_.profiling() && !pending_[q] && slot.launches > 0)
-      pending_[q] = PendingCall{sorted, first_event_, done, ray_count};
+    if (coherence == Coherence::scattered && st.scattered && device_.profiling() && !st.pending[q] && slot.launches > 0)
+      st.pending[q] = State::PendingCall{sorted, st.first_event, done, ray_count};
     ++slot.launches;
     return done;
   });
@@ -149,7 +171,7 @@ double Accel::last_call_ms(const cl::Event& done) const {
   return with_cl_errors([&] {
     done.wait();
     return static_cast<double>(done.getProfilingInfo<CL_PROFILING_COMMAND_END>() -
-                               first_event_.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
+                               state_->first_event.getProfilingInfo<CL_PROFILING_COMMAND_START>()) *
            1e-6;
   });
 }
@@ -181,3 +203,23 @@ std::vector<std::string> primitive_defines(const Geometry& geometry) {
 }
 
 }  // namespace rtcl
+
+namespace rtcl::detail {
+
+cl::Kernel& AccelAccess::kernel(const Accel& accel, const std::string& file, const std::string& kernel_name,
+                                const std::vector<std::string>& defines, cl_uint first_structure_arg) {
+  std::string key = file + ":" + kernel_name;
+  for (const std::string& define : defines) key += " " + define;
+  auto& kernels = accel.state_->query_kernels;
+  if (auto found = kernels.find(key); found != kernels.end()) return found->second;
+  std::vector<std::string> all = accel.defines_;
+  all.insert(all.end(), defines.begin(), defines.end());
+  cl::Program program = accel.device_.program(file, all);
+  return with_cl_errors([&]() -> cl::Kernel& {
+    cl::Kernel kernel(program, kernel_name.c_str());
+    accel.set_structure_args(kernel, first_structure_arg);
+    return kernels.emplace(key, std::move(kernel)).first->second;
+  });
+}
+
+}  // namespace rtcl::detail

@@ -1,6 +1,7 @@
 // Brute force: all primitives in id order, tested eight at a time. The
 // device-side reference every other structure is compared with.
 #include "rtcl/accel/brute.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 
 #include <chrono>
 

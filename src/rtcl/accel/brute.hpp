@@ -2,7 +2,7 @@
 
 #include <memory>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 
 namespace rtcl {
 

@@ -1,4 +1,5 @@
 #include "rtcl/accel/bsp.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 
 #include <algorithm>
 #include <cmath>

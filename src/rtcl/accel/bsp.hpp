@@ -12,6 +12,7 @@
 #include <memory>
 
 #include "rtcl/accel/kdtree_nodes.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 
 namespace rtcl {
 

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/bounds/aabb.hpp"
+#include "rtcl/aabb.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl {

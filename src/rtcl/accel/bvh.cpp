@@ -1,4 +1,5 @@
 #include "rtcl/accel/bvh.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 
 #include <algorithm>
 #include <cfloat>
@@ -93,6 +94,7 @@ class BvhAccel final : public Accel {
     kernel.setArg(first + 1, primitives_.triangles);
     kernel.setArg(first + 2, primitives_.spheres);
   }
+  bool plain_bvh8() const override { return true; }
 
   cl::Buffer nodes_;
   DevicePrimitives primitives_;

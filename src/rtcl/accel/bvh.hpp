@@ -13,7 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/accel/build_tree.hpp"
 #include "rtcl/accel/bvh_ploc.hpp"
 #include "rtcl/accel/bvh_sah.hpp"

@@ -23,7 +23,7 @@
 
 #include <glm/glm.hpp>
 
-#include "rtcl/bounds/aabb.hpp"
+#include "rtcl/aabb.hpp"
 #include "rtcl/layouts.hpp"
 
 namespace rtcl {

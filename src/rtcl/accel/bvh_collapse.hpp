@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "rtcl/accel/build_tree.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl {
 

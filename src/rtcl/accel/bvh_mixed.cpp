@@ -1,4 +1,5 @@
 #include "rtcl/accel/bvh_mixed.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 
 #include <chrono>
 

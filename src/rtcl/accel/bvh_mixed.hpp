@@ -8,7 +8,7 @@
 
 #include <memory>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/bvh_volumes.hpp"
 
 namespace rtcl {

@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <memory>
 
-#include "rtcl/accel/accel.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl {
 

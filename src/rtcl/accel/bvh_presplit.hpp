@@ -11,8 +11,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "rtcl/bounds/aabb.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/aabb.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl {
 

@@ -11,7 +11,8 @@
 #include <memory>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/accel/primitive_blocks.hpp"
 #include "rtcl/layouts.hpp"
 

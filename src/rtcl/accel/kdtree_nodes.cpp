@@ -1,4 +1,5 @@
 #include "rtcl/accel/kdtree_nodes.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 
 #include "rtcl/accel/kdtree_fused.hpp"
 

@@ -1,4 +1,5 @@
 #include "rtcl/accel/octree_ptr.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 
 #include <algorithm>
 #include <chrono>

@@ -11,7 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/accel/octree_build.hpp"
 #include "rtcl/accel/primitive_blocks.hpp"
 #include "rtcl/layouts.hpp"

@@ -14,7 +14,8 @@
 #include <memory>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
+#include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/accel/octree_build.hpp"
 #include "rtcl/accel/octree_ptr.hpp"
 

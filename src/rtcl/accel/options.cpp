@@ -1,4 +1,4 @@
-#include "rtcl/accel/options.hpp"
+#include "rtcl/accel_options.hpp"
 
 #include <charconv>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rtcl/accel/precision.hpp"
+#include "rtcl/precision.hpp"
 
 #include "rtcl/error.hpp"
 

@@ -6,10 +6,10 @@
 #include <span>
 #include <vector>
 
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/default_init_allocator.hpp"
 #include "rtcl/layouts.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl {
 

@@ -8,8 +8,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "rtcl/bounds/aabb.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/aabb.hpp"
+#include "rtcl/device.hpp"
 
 namespace rtcl {
 

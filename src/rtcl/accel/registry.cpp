@@ -3,7 +3,7 @@
 // file and one line here.
 #include <functional>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/brute.hpp"
 #include "rtcl/accel/bsp.hpp"
 #include "rtcl/accel/bvh.hpp"

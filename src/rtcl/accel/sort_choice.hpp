@@ -11,13 +11,10 @@
 #include <array>
 #include <cstdint>
 
+#include "rtcl/accel.hpp"
+
 namespace rtcl {
 
-enum class ScatteredSort {
-  measured,  // the faster of the two as measured (sorted until both are)
-  always,    // every scattered call sorts
-  never,     // no call sorts (scattered calls trace as incoherent ones)
-};
 
 class SortChoice {
  public:

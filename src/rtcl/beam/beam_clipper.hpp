@@ -10,7 +10,7 @@
 #include "rtcl/beam/beam_layouts.hpp"
 #include "rtcl/beam/screen_space.hpp"
 #include "rtcl/beam/tile_beams.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 
 namespace rtcl::beam {
 

@@ -9,7 +9,7 @@
 #include <unordered_map>
 #include <utility>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/beam/beam_cull.hpp"
 #include "rtcl/beam/beam_clipper.hpp"

@@ -28,7 +28,7 @@
 #include <string>
 
 #include "rtcl/beam/beam_clip_host.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/render/image.hpp"
 #include "rtcl/scene/scene.hpp"
 

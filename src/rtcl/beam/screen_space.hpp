@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "rtcl/render/camera.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl::beam {
 

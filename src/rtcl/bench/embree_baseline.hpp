@@ -12,10 +12,10 @@
 #include <span>
 #include <string>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/build_tree.hpp"
 #include "rtcl/layouts.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl::bench {
 

@@ -11,7 +11,7 @@
 
 #include "rtcl/bench/scene_catalog.hpp"
 #include "rtcl/layouts.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl::bench {
 

@@ -10,7 +10,7 @@
 
 #include <glm/glm.hpp>
 
-#include "rtcl/bounds/aabb.hpp"
+#include "rtcl/aabb.hpp"
 
 namespace rtcl::bench {
 

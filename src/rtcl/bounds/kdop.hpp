@@ -18,7 +18,7 @@
 #include <glm/glm.hpp>
 
 #include "rtcl/bounds/bounds_layouts.hpp"
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl {
 

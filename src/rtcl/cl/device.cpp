@@ -1,4 +1,4 @@
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 
 #include <algorithm>
 #include <atomic>

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/scene/scene.hpp"
 
 namespace rtcl {

@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 
 namespace rtcl {
 

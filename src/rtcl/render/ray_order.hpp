@@ -23,7 +23,7 @@
 #include <span>
 #include <vector>
 
-#include "rtcl/bounds/aabb.hpp"
+#include "rtcl/aabb.hpp"
 #include "rtcl/layouts.hpp"
 
 namespace rtcl {

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/render/render_layouts.hpp"
 
 namespace rtcl {

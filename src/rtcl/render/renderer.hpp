@@ -20,9 +20,9 @@
 #include <string_view>
 #include <vector>
 
-#include "rtcl/accel/accel.hpp"
+#include "rtcl/accel.hpp"
 #include "rtcl/accel/bvh_motion.hpp"
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/render_layouts.hpp"
 #include "rtcl/render/sampling_options.hpp"

@@ -1,4 +1,4 @@
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 #include <cmath>
 #include <vector>

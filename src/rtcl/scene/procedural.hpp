@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <string>
 
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl {
 

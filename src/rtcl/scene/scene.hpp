@@ -14,9 +14,9 @@
 
 #include <glm/glm.hpp>
 
-#include "rtcl/accel/precision.hpp"
+#include "rtcl/precision.hpp"
 
-#include "rtcl/scene/geometry.hpp"
+#include "rtcl/geometry.hpp"
 
 namespace rtcl {
 
@@ -130,7 +130,7 @@ struct Scene {
   // offsets (rtcl render --precision overrides it); none: robust.
   std::optional<Precision> precision;
   // "accel" of the scene file as a structure spec ("grid:lambda=4",
-  // rtcl/accel/options.hpp), checked when read: the structure rtcl render
+  // rtcl/accel_options.hpp), checked when read: the structure rtcl render
   // builds unless --accel is given. "" when the file names none.
   std::string accel;
 };

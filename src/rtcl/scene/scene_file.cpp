@@ -12,7 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
-#include "rtcl/accel/options.hpp"
+#include "rtcl/accel_options.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/motion.hpp"
 

@@ -7,7 +7,7 @@
 #include <string_view>
 #include <vector>
 
-#include "rtcl/cl/device.hpp"
+#include "rtcl/device.hpp"
 
 namespace rtcl {
 

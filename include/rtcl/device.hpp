@@ -8,7 +8,7 @@
 #include <string_view>
 #include <vector>
 
-#include "rtcl/cl/opencl.hpp"
+#include "rtcl/opencl.hpp"
 
 namespace rtcl {
 
