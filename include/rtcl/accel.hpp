@@ -110,8 +110,8 @@ class Accel {
   // or vertex counts once). counts.size() must equal rays.size().
   void count(const Rays& rays, std::span<std::uint32_t> counts) const;
   std::vector<std::uint32_t> count(const Rays& rays) const;
-  // Every crossing of every ray within [tmin, tmax], sorted by t; with
-  // max_hits_per_ray > 0 only that many nearest of each ray.
+  // Every crossing of every ray within [tmin, tmax] (as count counts them),
+  // sorted by t; at most max_hits_per_ray (>= 1) nearest of each ray.
   AllHits all_hits(const Rays& rays, std::uint32_t max_hits_per_ray = kAllHitsUnlimited) const;
   // For every point the nearest point of the surface within max_distance
   // (>= 0; +inf: anywhere), else a PointHit with prim = -1.

@@ -22,7 +22,8 @@ enum class Query {
 };
 
 inline constexpr float kUnlimitedDistance = std::numeric_limits<float>::infinity();
-inline constexpr std::uint32_t kAllHitsUnlimited = 0;
+// Accel::all_hits without a cap per ray.
+inline constexpr std::uint32_t kAllHitsUnlimited = 0xffffffffu;
 
 // Host rays, as Ray records or as separate arrays: origins and directions
 // (3 floats per ray, x y z) with optional tmin and tmax (1 float per ray;
