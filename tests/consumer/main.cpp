@@ -1,12 +1,9 @@
 // An application that already owns its OpenCL objects (made with the C API)
 // and uses rtcl as its ray-tracing backend: it adopts its context and queue,
 // builds a structure over its own arrays, and traces rays from its own cl_mem
-// buffers into its own cl_mem buffers. Exits 0 when the answers are right.
-#include <rtcl/accel.hpp>
-#include <rtcl/device.hpp>
-#include <rtcl/error.hpp>
-#include <rtcl/layouts.hpp>
-#include <rtcl/geometry.hpp>
+// buffers into its own cl_mem buffers, then the same rays from host arrays.
+// Only the public umbrella header. Exits 0 when the answers are right.
+#include <rtcl/rtcl.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -93,6 +90,17 @@ int main() try {
     expect(hits[1].prim == -1 && std::isinf(hits[1].t), label + ": ray 1 misses");
     expect(hits[2].prim == -1 && std::isinf(hits[2].t), label + ": ray 2 ends before the quad");
   }
+
+  // The same rays from host arrays: records, and separate origin and
+  // direction arrays with tmax.
+  std::vector<rtcl::Hit> host_hits = accel->intersect(std::span<const rtcl::Ray>(rays, 3));
+  expect(host_hits[0].prim == 1 && host_hits[0].t == 2.0f && host_hits[1].prim == -1 && host_hits[2].prim == -1,
+         name + " host records: hit, miss, miss");
+  const float origins[] = {0.25f, 0.5f, -2.0f, 3.0f, 0.0f, -2.0f, 0.25f, 0.5f, -2.0f};
+  const float directions[] = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+  const float tmax[] = {inf, inf, 1.5f};
+  std::vector<std::uint8_t> blocked = accel->occluded(rtcl::Rays(origins, directions, {}, tmax));
+  expect(blocked == std::vector<std::uint8_t>{1, 0, 0}, name + " host arrays: occluded, free, free");
 
   // A hit buffer one record short is refused before anything runs.
   cl_mem short_hits = clCreateBuffer(context, CL_MEM_WRITE_ONLY, 2 * sizeof(rtcl::Hit), nullptr, &status);

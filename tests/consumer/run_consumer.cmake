@@ -1,8 +1,11 @@
-# Installs a built rtcl into a fresh prefix, then configures, builds and runs
-# the consumer project (tests/consumer) against that prefix only.
+# Installs a built rtcl into a fresh prefix, checks that it ships exactly the
+# public headers, then configures, builds and runs the consumer project
+# (tests/consumer: its own program and the example of docs/api.md) against
+# that prefix only.
 # cmake -DRTCL_BUILD_DIR=... -DRTCL_LIBDIR=lib -DCONSUMER_SOURCE_DIR=...
-#       -DWORK_DIR=... -DGENERATOR=... -DCXX_COMPILER=... -P run_consumer.cmake
-foreach(var RTCL_BUILD_DIR RTCL_LIBDIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER)
+#       -DWORK_DIR=... -DGENERATOR=... -DCXX_COMPILER=... -DPUBLIC_INCLUDE_DIR=...
+#       -DAPI_DOC=.../docs/api.md -P run_consumer.cmake
+foreach(var RTCL_BUILD_DIR RTCL_LIBDIR CONSUMER_SOURCE_DIR WORK_DIR GENERATOR CXX_COMPILER PUBLIC_INCLUDE_DIR API_DOC)
   if(NOT DEFINED ${var})
     message(FATAL_ERROR "run_consumer.cmake: -D${var}=... is required")
   endif()
@@ -50,3 +53,32 @@ endif()
 run("build" "${CMAKE_COMMAND}" --build "${build}")
 run("run" "${build}/rtcl_consumer")
 message(STATUS "${output}")
+
+# The complete program of docs/api.md (the block between its
+# "api-example" markers), built against the prefix as a user copies it.
+file(READ "${API_DOC}" doc)
+string(REGEX MATCH "<!-- api-example: begin -->[^`]*```cpp\n(.*)\n```[^`]*<!-- api-example: end -->" found "${doc}")
+if(NOT found)
+  message(FATAL_ERROR "${API_DOC}: no ```cpp block between the api-example markers")
+endif()
+set(example "${WORK_DIR}/example")
+file(MAKE_DIRECTORY "${example}")
+file(WRITE "${example}/main.cpp" "${CMAKE_MATCH_1}\n")
+file(WRITE "${example}/CMakeLists.txt" "cmake_minimum_required(VERSION 3.20)
+project(api_example LANGUAGES CXX)
+set(CMAKE_CXX_STANDARD 20)
+find_package(rtcl 0.1 REQUIRED)
+add_executable(api_example main.cpp)
+target_link_libraries(api_example PRIVATE rtcl::rtcl)
+")
+run("configure the docs/api.md example" "${CMAKE_COMMAND}" -S "${example}" -B "${example}/build" -G "${GENERATOR}"
+    "-DCMAKE_CXX_COMPILER=${CXX_COMPILER}" -DCMAKE_BUILD_TYPE=Release "-DCMAKE_PREFIX_PATH=${prefix}"
+    -DCMAKE_FIND_USE_PACKAGE_REGISTRY=OFF -DCMAKE_FIND_USE_SYSTEM_PACKAGE_REGISTRY=OFF)
+run("build the docs/api.md example" "${CMAKE_COMMAND}" --build "${example}/build")
+run("run the docs/api.md example" "${example}/build/api_example")
+# The example's rays: one hits triangle 1 of the unit square at t = 1 (a
+# closed-form answer), the other misses.
+if(NOT output MATCHES "ray 0: t = 1, triangle 1\n" OR NOT output MATCHES "ray 1: miss\n")
+  message(FATAL_ERROR "the docs/api.md example printed:\n${output}")
+endif()
+message(STATUS "docs/api.md example:\n${output}")

@@ -21,6 +21,7 @@ Rays::Rays(std::span<const float> origins, std::span<const float> directions, st
   if (!tmax.empty() && tmax.size() != count_)
     throw Error("rays: tmax holds " + count(tmax) + " values for " + std::to_string(count_) + " rays");
   if (count_ > 0 && (!origins.data() || !directions.data())) throw Error("rays: null origins or directions");
+  if ((!tmin.empty() && !tmin.data()) || (!tmax.empty() && !tmax.data())) throw Error("rays: null tmin or tmax");
 }
 
 void Rays::pack(std::size_t first, std::span<Ray> out) const {
