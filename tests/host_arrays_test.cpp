@@ -13,11 +13,16 @@
 
 #include "rtcl/accel.hpp"
 #include "support/error_of.hpp"
+#include "support/everywhere.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"
 
 namespace rtcl::test {
 namespace {
+
+using everywhere::kNaN;
+using everywhere::make_ray;
+using everywhere::query_name;
 
 class ScopedEnv {
  public:

@@ -5,9 +5,10 @@
 #ifndef RTCL_SHARED_LAYOUTS_H
 #define RTCL_SHARED_LAYOUTS_H
 
-#include "query_layouts.h"
-
-#ifndef __OPENCL_VERSION__
+#ifdef __OPENCL_VERSION__
+#include "shared/query_layouts.h"
+#else
+#include <rtcl/shared/query_layouts.h>
 namespace rtcl {
 #endif
 
