@@ -24,9 +24,17 @@ set(build "${WORK_DIR}/build")
 file(REMOVE_RECURSE "${WORK_DIR}")
 
 run("install" "${CMAKE_COMMAND}" --install "${RTCL_BUILD_DIR}" --prefix "${prefix}")
-foreach(file include/rtcl/shared/layouts.h include/rtcl/layouts.hpp include/rtcl/accel.hpp
-             include/rtcl/device.hpp include/rtcl/opencl.hpp include/rtcl/geometry.hpp
-             include/rtcl/error.hpp ${RTCL_LIBDIR}/cmake/rtcl/rtclConfig.cmake
+# The installed headers are exactly the public set: include/rtcl/*.hpp of the
+# source tree and the query records they include.
+file(GLOB_RECURSE installed RELATIVE "${prefix}/include" "${prefix}/include/*")
+file(GLOB public RELATIVE "${PUBLIC_INCLUDE_DIR}" "${PUBLIC_INCLUDE_DIR}/rtcl/*.hpp")
+list(APPEND public rtcl/shared/query_layouts.h)
+list(SORT installed)
+list(SORT public)
+if(NOT installed STREQUAL public)
+  message(FATAL_ERROR "installed headers differ from the public set:\n  installed: ${installed}\n  public: ${public}")
+endif()
+foreach(file ${RTCL_LIBDIR}/cmake/rtcl/rtclConfig.cmake
              ${RTCL_LIBDIR}/cmake/rtcl/rtclConfigVersion.cmake ${RTCL_LIBDIR}/cmake/rtcl/rtclTargets.cmake)
   if(NOT EXISTS "${prefix}/${file}")
     message(FATAL_ERROR "install is incomplete: ${file} missing under ${prefix}")
