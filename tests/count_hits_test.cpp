@@ -106,7 +106,7 @@ void expect_matches_reference(const Accel& accel, const Geometry& g, const std::
   }
   EXPECT_EQ(failures, 0u) << what << ": " << first;
   EXPECT_GE(checked * 10, rays.size() * 9) << what << ": too many rays near a boundary case to be checked";
-  EXPECT_GT(total, rays.size()) << what << ": the rays should cross something";
+  EXPECT_GT(total, rays.size() / 2) << what << ": the rays should cross something";
 }
 
 // Rays of random_rays with the interval cut: tmax at a random fraction of
@@ -233,8 +233,11 @@ TEST(CountHits, SilhouetteTouchesAndInPlaneRaysCountZeroOrTwo) {
     }
     for (const glm::uvec3& t : c.mesh.triangles) {
       glm::vec3 a = c.mesh.vertices[t.x], b = c.mesh.vertices[t.y], cc = c.mesh.vertices[t.z];
-      rays.push_back(make_ray(a - 2.0f * (b - a), b - a));                         // along an edge
-      rays.push_back(make_ray((a + b + cc) / 3.0f - 3.0f * (b - a), b - a));       // in the face's plane
+      // from 3 units away (outside: the faces of the cube grid are
+      // coplanar with their neighbours)
+      glm::vec3 e = glm::normalize(b - a);
+      rays.push_back(make_ray(a - 3.0f * e, e));                    // along an edge
+      rays.push_back(make_ray((a + b + cc) / 3.0f - 3.0f * e, e));  // in the face's plane
     }
     if (std::string(c.name) == "cube grid") {
       for (float y : {-1.0f, -0.5f, 0.0f, 0.5f, 1.0f})

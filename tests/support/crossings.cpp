@@ -20,8 +20,17 @@ ReferenceCrossings reference_crossings(const Geometry& g, const Aabb& bounds, co
       out.ambiguous = true;
     return t >= ray.tmin && t <= ray.tmax;
   };
+  glm::dvec3 o(ray.ox, ray.oy, ray.oz), d(ray.dx, ray.dy, ray.dz);
+  const glm::dvec3 unit = d / glm::length(d);
   for (std::uint32_t p = 0; p < g.triangles.size(); ++p) {
     if (zero_area(g, p)) continue;
+    // a triangle whose bounding sphere (around vertex a) is clearly away
+    // from the ray's line cannot be near it
+    const glm::uvec3& tri = g.triangles[p];
+    glm::dvec3 a(g.vertices[tri.x]), b(g.vertices[tri.y]), c(g.vertices[tri.z]);
+    double radius = std::max(glm::length(b - a), glm::length(c - a));
+    glm::dvec3 to_a = a - o;
+    if (glm::length(to_a - glm::dot(to_a, unit) * unit) > 1.01 * radius + 2.0 * tol.space) continue;
     PrimHit h = reference_intersect(g, p, ray, tol);
     if (!h.plane) continue;
     bool clear_in = h.margin > tol.space, clear_out = h.margin < -tol.space;
@@ -33,7 +42,6 @@ ReferenceCrossings reference_crossings(const Geometry& g, const Aabb& bounds, co
     }
     if (range) out.hits.push_back({h.t, static_cast<std::int32_t>(p)});
   }
-  glm::dvec3 o(ray.ox, ray.oy, ray.oz), d(ray.dx, ray.dy, ray.dz);
   for (std::size_t s = 0; s < g.spheres.size(); ++s) {
     const Sphere& sphere = g.spheres[s];
     glm::dvec3 c(sphere.center);
