@@ -105,6 +105,52 @@ RTCL_LANES_INLINE int8 rtcl_watertight_hit8(const Watertight8* w, float8 sz, flo
   *t = T / *det;
   return inside & (*det != 0.0f) & (*t >= tmin) & (*t < t_best);
 }
+
+#ifdef RTCL_CROSSINGS
+/* Crossings (the count and all-hits queries, kernels/query/count_hits.cl;
+ * only kernels built with RTCL_CROSSINGS compile this): the watertight test
+ * with a tie-breaking fill rule, so that a ray through a shared edge or
+ * vertex of a closed mesh crosses it exactly once.
+ *
+ * Edge values exactly 0 (the ray's line meets the edge's line; at the
+ * robust level zeros are re-tested in double, so 0 is exact for the sheared
+ * float vertices) are decided as if the ray were moved by an infinitesimal
+ * eps * (1, -delta), delta << 1, in the sheared plane: an edge whose
+ * direction, taken with the triangle's interior on its right, is d counts
+ * as inside iff d.y > 0, or d.y == 0 and d.x > 0. Both triangles of an
+ * edge compute bitwise the same sheared vertices and exactly opposite edge
+ * values, so where they lie on opposite sides of the edge (the ray crosses
+ * it) they see opposite directions and exactly one owns the edge; where
+ * they lie on the same side (a silhouette) both or neither do (0 or 2).
+ * At a shared vertex the rule is the test of the moved ray, which lies on
+ * no edge: exactly one triangle of a fan around the vertex. A triangle
+ * whose projection has zero area (det == 0: a ray in its plane) is never
+ * hit. The lanes hit in [tmin, tmax], with *t and *det as
+ * rtcl_watertight_hit8's. */
+RTCL_LANES_INLINE int8 rtcl_edge_owned8(float8 dx, float8 dy) {
+  return (dy > 0.0f) | ((dy == 0.0f) & (dx > 0.0f));
+}
+
+RTCL_LANES_INLINE int8 rtcl_crossing_hit8(const Watertight8* w, float8 sz, float8 tmin, float8 tmax, float8* t,
+                                          float8* det) {
+  /* U, V, W = minus the orientation of the origin against B->C, C->A,
+   * A->B: where all are >= 0 the interior lies right of these directions,
+   * where all are <= 0 right of the reversed ones */
+  float8 bcx = w->Cx - w->Bx, bcy = w->Cy - w->By;
+  float8 cax = w->Ax - w->Cx, cay = w->Ay - w->Cy;
+  float8 abx = w->Bx - w->Ax, aby = w->By - w->Ay;
+  int8 pos = ((w->U > 0.0f) | ((w->U == 0.0f) & rtcl_edge_owned8(bcx, bcy))) &
+             ((w->V > 0.0f) | ((w->V == 0.0f) & rtcl_edge_owned8(cax, cay))) &
+             ((w->W > 0.0f) | ((w->W == 0.0f) & rtcl_edge_owned8(abx, aby)));
+  int8 neg = ((w->U < 0.0f) | ((w->U == 0.0f) & rtcl_edge_owned8(-bcx, -bcy))) &
+             ((w->V < 0.0f) | ((w->V == 0.0f) & rtcl_edge_owned8(-cax, -cay))) &
+             ((w->W < 0.0f) | ((w->W == 0.0f) & rtcl_edge_owned8(-abx, -aby)));
+  *det = w->U + w->V + w->W;
+  float8 T = sz * (w->U * w->Az + w->V * w->Bz + w->W * w->Cz);
+  *t = T / *det;
+  return (pos | neg) & (*det != 0.0f) & (*t >= tmin) & (*t <= tmax);
+}
+#endif
 #endif
 
 /* How intersect_triangle_lanes is compiled: a plain inline function, which

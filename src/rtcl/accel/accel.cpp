@@ -1,5 +1,7 @@
 #include "rtcl/accel.hpp"
 
+#include <algorithm>
+
 #include "rtcl/accel/accel_state.hpp"
 #include "rtcl/accel/structure_kernels.hpp"
 #include "rtcl/layouts.hpp"
@@ -207,12 +209,20 @@ std::vector<std::string> primitive_defines(const Geometry& geometry) {
 namespace rtcl::detail {
 
 cl::Kernel& AccelAccess::kernel(const Accel& accel, const std::string& file, const std::string& kernel_name,
-                                const std::vector<std::string>& defines, cl_uint first_structure_arg) {
+                                const std::vector<std::string>& defines, cl_uint first_structure_arg,
+                                std::optional<Precision> level) {
   std::string key = file + ":" + kernel_name;
+  if (level) key += " @" + std::string(precision_name(*level));
   for (const std::string& define : defines) key += " " + define;
   auto& kernels = accel.state_->query_kernels;
   if (auto found = kernels.find(key); found != kernels.end()) return found->second;
   std::vector<std::string> all = accel.defines_;
+  if (level && *level != accel.precision_) {
+    // defines_ ends with the structure level's options (with_precision)
+    const std::vector<std::string> own = precision_build_options(accel.precision_);
+    std::erase_if(all, [&](const std::string& d) { return std::find(own.begin(), own.end(), d) != own.end(); });
+    for (std::string& d : precision_build_options(*level)) all.push_back(std::move(d));
+  }
   all.insert(all.end(), defines.begin(), defines.end());
   cl::Program program = accel.device_.program(file, all);
   return with_cl_errors([&]() -> cl::Kernel& {

@@ -72,9 +72,13 @@ struct AccelAccess {
   // Kernel `kernel_name` of kernels/`file`, built with the structure's
   // defines plus `defines`, its structure arguments set from argument
   // `first_structure_arg` on (Accel::set_structure_args); built once per
-  // structure, file, kernel and defines. Call with mutex(accel) held.
+  // structure, file, kernel and defines. `level`: built at that precision
+  // level instead of the structure's (its options replace the structure's
+  // precision_build_options), for a query that fixes its own arithmetic.
+  // Call with mutex(accel) held.
   static cl::Kernel& kernel(const Accel& accel, const std::string& file, const std::string& kernel_name,
-                            const std::vector<std::string>& defines, cl_uint first_structure_arg);
+                            const std::vector<std::string>& defines, cl_uint first_structure_arg,
+                            std::optional<Precision> level = std::nullopt);
   static cl::Event trace(const Accel& accel, Query query, const cl::Buffer& rays, const cl::Buffer& hits,
                          std::size_t ray_count, const std::vector<cl::Event>& wait, Coherence coherence) {
     return accel.trace_locked(query, rays, hits, ray_count, wait, coherence);
