@@ -33,6 +33,22 @@ std::string read_kernel_file(const std::string& path) {
   return std::string(it->second);
 }
 
+bool kernel_file_exists(const std::string& path) {
+  if (const char* dir = std::getenv("RTCL_KERNEL_DIR"); dir && *dir)
+    return static_cast<bool>(std::ifstream(std::string(dir) + "/" + path));
+  return embedded_kernels().count(path) > 0;
+}
+
+// As the C preprocessor resolves #include "name": beside the including file
+// first (shared/layouts.h includes "query_layouts.h", a name that also
+// resolves in C++), else from the kernels/ root.
+std::string resolve_include(const std::string& includer, const std::string& name) {
+  const std::size_t slash = includer.rfind('/');
+  if (slash == std::string::npos) return name;
+  std::string beside = includer.substr(0, slash + 1) + name;
+  return kernel_file_exists(beside) ? beside : name;
+}
+
 void inline_includes(const std::string& path, std::set<std::string>& seen, std::string& out) {
   if (!seen.insert(path).second) return;
   static const std::regex include_line(R"(^\s*#\s*include\s*"([^"]+)\"\s*$)");
@@ -44,7 +60,7 @@ void inline_includes(const std::string& path, std::set<std::string>& seen, std::
     ++number;
     std::smatch m;
     if (std::regex_match(line, m, include_line)) {
-      inline_includes(m[1].str(), seen, out);
+      inline_includes(resolve_include(path, m[1].str()), seen, out);
       out += "#line " + std::to_string(number + 1) + " \"" + path + "\"\n";
     } else {
       out += line;
