@@ -85,7 +85,7 @@ std::vector<std::uint8_t> Accel::occupancy(const Points& points, unsigned nsampl
   std::span<const float> xyz = points.xyz();
   for (std::size_t i = 0; i < xyz.size(); ++i)
     if (!std::isfinite(xyz[i]))
-      throw Error("occupancy: points[" + std::to_string(i / 3) + "] is not finite");
+      throw Error("occupancy: points[" + std::to_string(i / 3) + "] has a NaN or infinite coordinate");
   return inside_votes(*this, points, nsamples);
 }
 
