@@ -30,7 +30,7 @@
 #include "distributed.hpp"
 #include "flag_names.hpp"
 #include "rtcl/accel.hpp"
-#include "rtcl/bench/ray_sets.hpp"
+#include "bench/support/ray_sets.hpp"
 #include "rtcl/render/ray_order.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
