@@ -15,7 +15,7 @@
 #include "bench_scenes.hpp"
 
 #ifdef RTCL_HAVE_EMBREE
-#include "rtcl/bench/embree_baseline.hpp"
+#include "bench/support/embree_baseline.hpp"
 #endif
 
 int main(int argc, char** argv) {

@@ -15,7 +15,7 @@
 #include "rtcl/scene/mesh_io.hpp"
 
 #ifdef RTCL_HAVE_EMBREE
-#include "rtcl/bench/embree_baseline.hpp"
+#include "bench/support/embree_baseline.hpp"
 #endif
 
 namespace rtcl::bench {

@@ -13,7 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "rtcl/accel.hpp"
-#include "rtcl/bench/scene_catalog.hpp"
+#include "bench/support/scene_catalog.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/geometry.hpp"
@@ -37,7 +37,7 @@ inline constexpr RayKind ordered_ray_kinds[] = {RayKind::primary_tiled, RayKind:
 const char* ray_kind_name(RayKind kind);
 Query ray_kind_query(RayKind kind);
 
-// Camera, SceneSpec and scene_specs(): rtcl/bench/scene_catalog.hpp.
+// Camera, SceneSpec and scene_specs(): bench/support/scene_catalog.hpp.
 
 // $RTCL_SCENES_DIR, else the ../shared/scenes beside the source tree.
 std::string scenes_dir();

@@ -15,7 +15,7 @@
 #include <string>
 
 #include "bench_scenes.hpp"
-#include "rtcl/bench/embree_baseline.hpp"
+#include "bench/support/embree_baseline.hpp"
 
 namespace rtcl::bench {
 namespace {

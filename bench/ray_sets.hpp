@@ -1,11 +1,11 @@
 // Ray-set previews for the benchmark scenes; the rays themselves come from
-// rtcl/bench/ray_sets.hpp (shared with `rtcl bench`).
+// bench/support/ray_sets.hpp (shared with `rtcl bench`).
 #pragma once
 
 #include <string>
 
 #include "bench_scenes.hpp"
-#include "rtcl/bench/ray_sets.hpp"
+#include "bench/support/ray_sets.hpp"
 
 namespace rtcl::bench {
 

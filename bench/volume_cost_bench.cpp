@@ -2,13 +2,14 @@
 // (VolumeCosts in src/rtcl/accel/bvh_volumes.hpp): one node's eight-box
 // slab test, its eight-sphere, 14-DOP-diagonal and OBB filters, and one
 // eight-triangle leaf block, each
-// run by kernels/bench/volume_costs.cl over the bunny BVH's first records for
+// run by bench/kernels/volume_costs.cl over the bunny BVH's first records for
 // the bunny's diffuse rays. Counter ns_per_test: kernel time / (rays x records).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <cmath>
 
+#include "bench/support/bench_kernels.hpp"
 #include "bench_scenes.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/device.hpp"
@@ -103,7 +104,7 @@ void volume_cost(benchmark::State& state, const char* kernel_name) {
     else
       records = device.upload(bvh.blocks.triangles.data(), count * sizeof(TriangleBlock), "blocks");
     cl::Buffer out = device.allocate(rays.size() * sizeof(cl_int), "counts");
-    cl::Kernel k(device.program("bench/volume_costs.cl", {}), kernel_name);
+    cl::Kernel k(bench_program(device, "volume_costs.cl"), kernel_name);
     k.setArg(0, ray_buffer);
     k.setArg(1, records);
     k.setArg(2, static_cast<cl_uint>(count));

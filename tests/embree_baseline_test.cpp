@@ -1,4 +1,4 @@
-// The Embree baseline's scene (src/rtcl/bench/embree_baseline.hpp) holds
+// The Embree baseline's scene (bench/support/embree_baseline.hpp) holds
 // the geometry's triangles and spheres, and its answers carry rtcl's
 // primitive ids: judged against the double-precision brute force, single
 // rays and 8-ray packets. Built only with Embree.
@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "rtcl/bench/embree_baseline.hpp"
+#include "bench/support/embree_baseline.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"
 

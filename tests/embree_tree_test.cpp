@@ -1,5 +1,5 @@
 // Embree's binary SAH tree as a BvhConfig::custom_builder
-// (src/rtcl/bench/embree_baseline.hpp): a well-formed tree over exactly the
+// (bench/support/embree_baseline.hpp): a well-formed tree over exactly the
 // given ids, traced by the bvh kernels like rtcl's own tree. Built only with
 // Embree.
 #include <gtest/gtest.h>
@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "rtcl/accel/bvh.hpp"
-#include "rtcl/bench/embree_baseline.hpp"
+#include "bench/support/embree_baseline.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"
 

@@ -396,7 +396,7 @@ TEST(MotionRender, ZeroMotionEqualsTheStaticScene) {
 
 TEST(MotionRender, MovingSceneNeedsTheBvhAndStaticLamps) {
   Scene scene = moving_default_scene();
-  EXPECT_NE(error_of([&] { Renderer(test_device(), scene, "grid"); }).find("--accel grid"), std::string::npos);
+  EXPECT_NE(error_of([&] { Renderer(test_device(), scene, "grid"); }).find("Renderer accel \"grid\": "), std::string::npos);
   Scene lamp = scene;
   lamp.lights = {Light{}};
   lamp.lights[0].shape = LightShape::emissive;

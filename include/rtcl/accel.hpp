@@ -239,9 +239,12 @@ std::vector<std::string> accel_names();
 // Builds the named structure over validated geometry and uploads it: the
 // one way to make a structure. `name` is a structure name or a spec with
 // options, "grid:lambda=4,res=64x32x16" (parse_accel_spec); config.options
-// are applied after the spec's. Throws Error naming `name` when the
-// structure or an option is unknown, of the wrong type or out of range,
-// and naming `config.precision` when the device cannot run that level.
+// are applied after the spec's; the options are checked and completed with
+// their declared defaults here, once. Throws Error naming `name` when the
+// structure or an option is unknown, of the wrong type or out of range
+// (make_accel name "grid:lambda=-1": lambda must be > 0 and <= 1024), and
+// naming the level when the device cannot run config.precision
+// (precision "exact": ...).
 std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry,
                                   const AccelConfig& config = {});
 

@@ -76,10 +76,11 @@ struct AccelSpec {
 };
 
 // Parses and validates a spec against the registry (structure_spec).
-// Errors read "--accel TEXT: PROBLEM", e.g. "--accel grid:lambda=-1: lambda
-// must be > 0", "--accel grid:foo=1: unknown option foo of grid (options:
-// lambda, res)".
-// `context` replaces "--accel TEXT" in errors when given (scene files).
+// Errors read "CONTEXT: PROBLEM", by default with the context accel "TEXT",
+// e.g. accel "grid:lambda=-1": lambda must be > 0, accel "grid:foo=1":
+// unknown option foo of grid (options: lambda, res, ...). `context`
+// replaces accel "TEXT" when given: make_accel's make_accel name "TEXT",
+// a scene file's "FILE: accel", the CLI's "--accel TEXT".
 AccelSpec parse_accel_spec(std::string_view text, const std::string& context = {});
 
 // "grid:lambda=4,res=64x32x16" (options in name order); just the name when
@@ -104,7 +105,7 @@ std::string option_range_text(const OptionSpec& spec);
 
 // The registry's structures, in accel_names() order (registry.cpp).
 const std::vector<StructureSpec>& structure_specs();
-// Throws Error "--accel NAME: unknown acceleration structure (known: ...)".
+// Throws Error accel "NAME": unknown acceleration structure (known: ...).
 const StructureSpec& structure_spec(std::string_view name);
 
 }  // namespace rtcl

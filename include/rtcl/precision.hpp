@@ -32,13 +32,15 @@ enum class Precision {
 const std::vector<std::string>& precision_names();
 std::string_view precision_name(Precision precision);
 
-// Throws Error "--precision NAME: unknown precision level (known: ...)".
+// Throws Error "precision "NAME": unknown precision level (known: ...)".
 Precision parse_precision(std::string_view name);
 
 // "" when the device can run the level, else why not (exact without fp64).
 std::string precision_unsupported(const DeviceInfo& device, Precision precision);
 
-// Throws Error naming --precision when precision_unsupported is not "".
+// Throws Error "precision "NAME": WHY" when precision_unsupported is not "",
+// e.g. precision "exact": exact needs double precision on the device
+// (cl_khr_fp64), which DEVICE lacks.
 void require_precision(const DeviceInfo& device, Precision precision);
 
 // The program options of a trace kernel at this level: -D defines

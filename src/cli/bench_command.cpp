@@ -28,8 +28,9 @@
 #include "rtcl/opencl.hpp"
 #include "commands.hpp"
 #include "distributed.hpp"
+#include "flag_names.hpp"
 #include "rtcl/accel.hpp"
-#include "rtcl/bench/ray_sets.hpp"
+#include "bench/support/ray_sets.hpp"
 #include "rtcl/render/ray_order.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
@@ -226,7 +227,7 @@ BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) 
   m.accels = options.accel.empty() ? default_accels() : split_spec_list(options.accel);
   for (const std::string& a : m.accels) {
     if (a.empty()) throw UsageError("--accel " + options.accel + ": empty structure name in the list");
-    parse_accel_spec(a);  // unknown structure or option: "--accel TEXT: ..."
+    parse_accel_flag(a);  // unknown structure or option: "--accel TEXT: ..."
   }
   std::string scenes_dir = options.scenes_dir.empty() ? default_scenes_dir() : options.scenes_dir;
   for (const std::string& s : split_spec_list(options.scene)) m.scenes.push_back(parse_bench_scene(s, scenes_dir));
@@ -237,7 +238,7 @@ BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) 
     m.kinds.push_back(static_cast<int>(k - std::begin(kind_names)));
   }
   try {
-    m.precision = parse_precision(options.precision);
+    m.precision = parse_precision_flag(options.precision);
   } catch (const Error& e) {
     throw UsageError(e.what());
   }
@@ -403,7 +404,7 @@ void run_bench(const BenchOptions& options) {
     for (const DeviceInfo& info : infos) devices.push_back(Device::open(std::to_string(info.index)));
   }
   for (const Device& device : devices) {
-    require_precision(device.info(), matrix.precision);
+    require_precision_flag(device.info(), matrix.precision);
     run.devices.push_back(describe_device(device));
   }
   if (!options.no_embree) run.embree_version = embree_baseline_version(options.embree_threads);

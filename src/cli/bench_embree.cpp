@@ -6,7 +6,7 @@
 #include "rtcl/error.hpp"
 
 #ifdef RTCL_HAVE_EMBREE
-#include "rtcl/bench/embree_baseline.hpp"
+#include "bench/support/embree_baseline.hpp"
 #endif
 
 namespace rtcl::cli {

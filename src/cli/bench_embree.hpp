@@ -1,4 +1,4 @@
-// The Embree baseline of `rtcl bench` (src/rtcl/bench/embree_baseline.hpp):
+// The Embree baseline of `rtcl bench` (bench/support/embree_baseline.hpp):
 // the very rays of a cell traced by Embree on host threads, timed as
 // Embree's own framing has it: the traversal alone (the rays converted into
 // Embree's records before it and the answers read after it, as rtcl's

@@ -1,4 +1,4 @@
-// The scenes of `rtcl bench`: the shared meshes of rtcl/bench/scene_catalog
+// The scenes of `rtcl bench`: the shared meshes of bench/support/scene_catalog
 // ("bunny", ...) and procedural ones built at a chosen size
 // (rtcl/scene/procedural.hpp): "sphereflake:levels=3", "tetra:levels=6",
 // "mount:levels=6", "soup:count=100000", "teapot-stadium" is a mesh spec.
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "rtcl/bench/scene_catalog.hpp"
+#include "bench/support/scene_catalog.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/geometry.hpp"
 

@@ -11,6 +11,7 @@
 #include "accel_option.hpp"
 #include "commands.hpp"
 #include "distributed.hpp"
+#include "flag_names.hpp"
 #include "render_options.hpp"
 #include "render_units.hpp"
 #include "rtcl/accel.hpp"
@@ -138,25 +139,28 @@ void run(const RenderOptions& o) {
     if (!o.frames.empty() || !o.spp_sweep.empty())
       throw Error(std::string(o.frames.empty() ? "--spp-sweep" : "--frames") +
                   ": not with --method beam (it renders one static image)");
-    if (!o.accel.empty()) parse_accel_spec(o.accel);
+    if (!o.accel.empty()) parse_accel_flag(o.accel);
     return run_beam(o);
   }
   if (launcher_world_size()) {
     refuse_ranks_without_mpi("rtcl render");
     if (mpi_supported()) return render_distributed(o);
   }
-  if (!o.accel.empty()) parse_accel_spec(o.accel);  // before the scene is loaded
+  if (!o.accel.empty()) parse_accel_flag(o.accel);  // before the scene is loaded
   Scene scene = load_render_scene(o);
   RenderPlan plan = plan_render(o, scene);
   RenderUnits units = plan_units(o, scene, plan.settings.spp);  // checks the output paths before the long work
   Device device = Device::open(o.device);
-  require_precision(device.info(), plan.config.precision);
+  require_precision_flag(device.info(), plan.config.precision);
   std::unique_ptr<Renderer> renderer;
   for (const RenderUnit& unit : units.units) {
     // A frame is a scene of its own (its shutter interval); a sweep's
     // images share the renderer.
     if (!renderer || units.kind == UnitKind::frames)
-      renderer = std::make_unique<Renderer>(device, unit_scene(scene, units, unit), plan.accel, plan.config);
+      // A structure given by --accel is named so in the renderer's errors.
+      renderer = naming_accel_flag(o.accel, [&] {
+        return std::make_unique<Renderer>(device, unit_scene(scene, units, unit), plan.accel, plan.config);
+      });
     RenderPlan unit_plan = plan;
     unit_plan.settings.spp = unit.spp;
     if (o.method != "ray") {
@@ -201,7 +205,7 @@ RenderPlan plan_render(const RenderOptions& o, const Scene& scene) {
   settings.seed = o.seed;
   settings.light_samples = o.light_samples;
   plan.config.precision =
-      !o.precision.empty() ? parse_precision(o.precision) : scene.precision.value_or(Precision::robust);
+      !o.precision.empty() ? parse_precision_flag(o.precision) : scene.precision.value_or(Precision::robust);
   plan.accel = !o.accel.empty() ? o.accel : !scene.accel.empty() ? scene.accel : default_accel();
   return plan;
 }

@@ -12,6 +12,7 @@
 
 #include "accel_option.hpp"
 #include "commands.hpp"
+#include "flag_names.hpp"
 #include "rtcl/accel.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
@@ -83,9 +84,9 @@ double mrays_per_s(std::size_t rays, double ms) { return ms > 0.0 ? static_cast<
 
 void run_trace(const TraceOptions& options) {
   std::string accel_name = accel_or_default(options.accel);
-  parse_accel_spec(accel_name);  // name and options checked before any work
+  parse_accel_flag(accel_name);  // name and options checked before any work
   AccelConfig config;
-  config.precision = parse_precision(options.precision);
+  config.precision = parse_precision_flag(options.precision);
   check_writable(options.hits);
 
   Clock::time_point load_start = Clock::now();
@@ -100,7 +101,7 @@ void run_trace(const TraceOptions& options) {
 
   Device device = Device::open(options.device);
   const DeviceInfo& info = device.info();
-  require_precision(info, config.precision);
+  require_precision_flag(info, config.precision);
   std::printf("device: [%zu] %s (%s)\n", info.index, info.name.c_str(), info.platform.c_str());
   std::printf("mesh:   %s: %zu triangles, %zu vertices, %zu objects, loaded in %.1f ms\n", options.mesh.c_str(),
               mesh.geometry.triangles.size(), mesh.geometry.vertices.size(), mesh.objects.size(), load_ms);

@@ -15,6 +15,7 @@
 
 #include "distributed.hpp"
 #include "exit_codes.hpp"
+#include "flag_names.hpp"
 #include "mpi/fault_injection.hpp"
 #include "mpi/job_farm.hpp"
 #include "mpi/mpi_world.hpp"
@@ -153,7 +154,7 @@ void run(MpiWorld& world, const RenderOptions& o) {
   if (root) {
     nlohmann::json header;
     try {
-      if (!o.accel.empty()) parse_accel_spec(o.accel);
+      if (!o.accel.empty()) parse_accel_flag(o.accel);
       Clock::time_point start = Clock::now();
       scene = load_render_scene(o);
       scene_ms = ms_since(start);
@@ -210,10 +211,12 @@ void run(MpiWorld& world, const RenderOptions& o) {
     report["scene_ms"] = broadcast ? broadcast_ms : scene_ms;
     mine.device = std::make_unique<Device>(open_rank_device(o.device, world.local_rank));
     report["device"] = mine.device->info().name;
-    require_precision(mine.device->info(), plan.config.precision);
+    require_precision_flag(mine.device->info(), plan.config.precision);
     Clock::time_point start = Clock::now();
-    mine.renderer = std::make_unique<Renderer>(*mine.device, unit_scene(scene, units, units.units.front()),
-                                               plan.accel, plan.config);
+    mine.renderer = naming_accel_flag(o.accel, [&] {
+      return std::make_unique<Renderer>(*mine.device, unit_scene(scene, units, units.units.front()), plan.accel,
+                                        plan.config);
+    });
     // Warm-up: PoCL generates a kernel's code at its first launch; one
     // tile rendered and dropped keeps that out of the tiles' times.
     mine.renderer->render(plan.settings, tiles.front());
@@ -229,8 +232,10 @@ void run(MpiWorld& world, const RenderOptions& o) {
     const std::size_t u = job / tiles.size();
     if (units.kind == UnitKind::frames && u != mine.unit) {
       mine.renderer.reset();
-      mine.renderer = std::make_unique<Renderer>(*mine.device, unit_scene(scene, units, units.units.at(u)), plan.accel,
-                                                 plan.config);
+      mine.renderer = naming_accel_flag(o.accel, [&] {
+        return std::make_unique<Renderer>(*mine.device, unit_scene(scene, units, units.units.at(u)), plan.accel,
+                                          plan.config);
+      });
       mine.unit = u;
     }
     RenderSettings settings = plan.settings;

@@ -192,10 +192,12 @@ std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device) 
 
 bool packets_for_coherent_calls(const DeviceInfo& device) { return device.type == "cpu"; }
 
-OptionSpec occluder_run_option() {
-  return {"occluder_run", OptionType::integer, std::int64_t{0}, 0, 1024, false,
+const OptionSpec& occluder_run_option() {
+  static const OptionSpec spec{"occluder_run", OptionType::integer, std::int64_t{0}, 0, 1024, false,
           "occlusion queries: rays (packets of 8 in a packet kernel) per work-item, each tested first against the "
-          "leaf that blocked the previous one (1 = no such test; 0 = 16 on CPU devices, 1 on others)"};
+          "leaf that blocked the previous one (1 = no such test; 0 = " + std::to_string(kCpuOccluderRun) +
+          " on CPU devices, 1 on others)"};
+  return spec;
 }
 
 std::vector<std::string> primitive_defines(const Geometry& geometry) {

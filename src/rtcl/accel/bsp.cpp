@@ -127,7 +127,7 @@ std::unique_ptr<Accel> make_bsp(const Device& device, const Geometry& geometry, 
 }
 
 std::unique_ptr<Accel> make_bsp_accel(const Device& device, const Geometry& geometry, const AccelConfig& config) {
-  AccelOptions o = resolve_options(bsp_structure(), config.options, "--accel bsp");
+  const AccelOptions& o = config.options;
   BspConfig bsp;
   bsp.depth = static_cast<int>(o.integer("depth"));
   bsp.leaf_size = static_cast<int>(o.integer("leaf"));

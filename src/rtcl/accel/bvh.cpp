@@ -217,40 +217,49 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
 
 namespace {
 
-OptionSpec merge_leaves_option() {
-  return {"merge_leaves", OptionType::boolean, true, 0, 0, false,
+// The options the BVH structures share, each declared once (defaults: the
+// config structs' own).
+const OptionSpec& merge_leaves_option() {
+  static const OptionSpec spec{"merge_leaves", OptionType::boolean, BvhConfig{}.merge_leaves, 0, 0, false,
           "two leaves of a wide node share a block when they fit in 8 lanes and the SAH allows: fewer block "
           "tests and bytes; rarely applies to SAH trees"};
+  return spec;
 }
-OptionSpec greedy_levels_option() {
-  return {"greedy_levels", OptionType::integer, std::int64_t{BvhConfig{}.greedy_levels}, 0, 1024, false,
+const OptionSpec& greedy_levels_option() {
+  static const OptionSpec spec{"greedy_levels", OptionType::integer, std::int64_t{BvhConfig{}.greedy_levels}, 0, 1024, false,
           "top wide levels that open their largest child until eight; below, each wide node takes the "
           "SAH-optimal layout of its subtree: 2 traced 11 of 12 bench/ sets up to 5% faster than greedy throughout, 0 "
           "(optimal throughout) sponza's primary rays 1-12% slower"};
+  return spec;
 }
-OptionSpec node_cost_option() {
-  return {"node_cost", OptionType::real, 0.5, 0, 64, true,
+// SAH and PLOC builds share the node cost's and the leaf cap's defaults.
+static_assert(SahConfig{}.node_cost == PlocConfig{}.node_cost && SahConfig{}.max_leaf_size == PlocConfig{}.max_leaf_size);
+const OptionSpec& node_cost_option() {
+  static const OptionSpec spec{"node_cost", OptionType::real, double{SahConfig{}.node_cost}, 0, 64, true,
           "cost of entering a binary node relative to one 8-primitive block test: higher gives shallower trees "
           "with fuller leaves, lower splits more eagerly"};
+  return spec;
 }
-OptionSpec presplit_option() {
-  return {"presplit", OptionType::real, 0.0, 0, 1024, false,
+const OptionSpec& presplit_option() {
+  static const OptionSpec spec{"presplit", OptionType::real, double{BvhConfig{}.presplit}, 0, 1024, false,
           "split the references of triangles whose box's area exceeds presplit x the mean (0 = off): at 16 "
           "sponza's primary rays 1.08-1.16x faster, diffuse bounces 0.97-1.03x, 3-13% more build time"};
+  return spec;
 }
-OptionSpec max_leaf_size_option() {
-  return {"max_leaf_size", OptionType::integer, std::int64_t{8}, 1, 8, false,
+const OptionSpec& max_leaf_size_option() {
+  static const OptionSpec spec{"max_leaf_size", OptionType::integer, std::int64_t{SahConfig{}.max_leaf_size}, 1, 8, false,
           "largest leaf; leaves tend to fill the 8 lanes, a smaller cap only adds nodes"};
+  return spec;
 }
 
 const std::vector<OptionSpec>& sah_options() {
   static const std::vector<OptionSpec> options = {
-      {"bin_count", OptionType::integer, std::int64_t{32}, 2, 256, false,
+      {"bin_count", OptionType::integer, std::int64_t{SahConfig{}.bin_count}, 2, 256, false,
        "SAH bins per axis: more find better planes where density is uneven (sponza primary rays +18% from 16 to "
        "32), at ~10% more build time"},
       node_cost_option(),
       max_leaf_size_option(),
-      {"max_sah_depth", OptionType::integer, std::int64_t{48}, 1, 1024, false,
+      {"max_sah_depth", OptionType::integer, std::int64_t{SahConfig{}.max_sah_depth}, 1, 1024, false,
        "deeper nodes split at the object median: bounds the depth and traversal stack, at some quality loss"},
       merge_leaves_option(),
       greedy_levels_option(),
@@ -260,8 +269,11 @@ const std::vector<OptionSpec>& sah_options() {
   return options;
 }
 
-BvhConfig bvh_config(const StructureSpec& structure, const AccelConfig& config) {
-  AccelOptions o = resolve_options(structure, config.options, "--accel " + structure.name);
+}  // namespace
+
+const std::vector<OptionSpec>& bvh_sah_options() { return sah_options(); }
+
+BvhConfig bvh_config_from(const AccelOptions& o) {
   BvhConfig bvh;
   bvh.merge_leaves = o.boolean("merge_leaves");
   bvh.greedy_levels = static_cast<std::uint32_t>(o.integer("greedy_levels"));
@@ -282,14 +294,6 @@ BvhConfig bvh_config(const StructureSpec& structure, const AccelConfig& config) 
   return bvh;
 }
 
-}  // namespace
-
-const std::vector<OptionSpec>& bvh_sah_options() { return sah_options(); }
-
-BvhConfig resolve_bvh_config(const StructureSpec& structure, const AccelConfig& config) {
-  return bvh_config(structure, config);
-}
-
 const StructureSpec& bvh_structure() {
   static const StructureSpec spec{
       "bvh", "8-wide BVH, top-down binned SAH; packets of 8 rays for coherent calls on CPU devices", sah_options()};
@@ -299,12 +303,12 @@ const StructureSpec& bvh_structure() {
 const StructureSpec& bvh_ploc_structure() {
   static const StructureSpec spec{
       "bvh-ploc", "8-wide BVH, bottom-up agglomerative clustering (PLOC)",
-      {{"search_radius", OptionType::integer, std::int64_t{16}, 1, 1024, false,
+      {{"search_radius", OptionType::integer, std::int64_t{PlocConfig{}.search_radius}, 1, 1024, false,
         "clusters searched on each side in Morton order: larger finds closer partners (bunny: r=4 / 64 trace 7% "
         "slower / 3% faster than 16) at a build cost linear in r"},
        node_cost_option(),
        max_leaf_size_option(),
-       {"max_depth", OptionType::integer, std::int64_t{64}, 1, 1024, false,
+       {"max_depth", OptionType::integer, std::int64_t{PlocConfig{}.max_depth}, 1, 1024, false,
         "subtrees reaching this depth are rebuilt by median splits: bounds the stack for chain-forming inputs"},
        merge_leaves_option(),
        greedy_levels_option(),
@@ -320,15 +324,15 @@ const StructureSpec& bvh_packet_structure() {
 }
 
 std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry, const AccelConfig& config) {
-  return make_bvh(device, geometry, bvh_config(bvh_structure(), config), "bvh", config);
+  return make_bvh(device, geometry, bvh_config_from(config.options), "bvh", config);
 }
 
 std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry, const AccelConfig& config) {
-  return make_bvh(device, geometry, bvh_config(bvh_ploc_structure(), config), "bvh-ploc", config);
+  return make_bvh(device, geometry, bvh_config_from(config.options), "bvh-ploc", config);
 }
 
 std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry, const AccelConfig& config) {
-  BvhConfig bvh = bvh_config(bvh_packet_structure(), config);
+  BvhConfig bvh = bvh_config_from(config.options);
   bvh.traversal = BvhTraversal::packet;
   return make_bvh(device, geometry, bvh, "bvh-packet", config);
 }

@@ -49,8 +49,9 @@ struct BvhConfig {
   // primitives fit in eight lanes and the SAH does not object (the union's
   // area is at most the sum of theirs): one block test instead of two, fewer
   // bytes. Rarely applies to SAH trees, whose leaves are already full
-  // (counted with rtcl_tree_visits: 2 blocks of the bunny's 9,631 saved, 49
-  // of sponza's 9,890); off changes nothing else.
+  // (counted with rtcl_tree_visits, since removed, docs/benchmarks.md: 2
+  // blocks of the bunny's 9,631 saved, 49 of sponza's 9,890); off changes
+  // nothing else.
   bool merge_leaves = true;
   // Collapse: the wide nodes of the top greedy_levels levels (the root's
   // is level 1) keep opening their child of largest area until they have
@@ -82,8 +83,8 @@ struct BvhConfig {
   // kind of primitive the geometry has (triangles, spheres; never with
   // none) with their boxes and ids, it returns a tree over exactly those ids
   // with leaves of 1..8 (the flatten checks it and throws Error otherwise).
-  // For comparing builders on the same kernels: bench/kernel_ab traces
-  // Embree's binned SAH tree (embree_baseline.hpp) this way.
+  // For comparing builders on the same kernels: Embree's binned SAH tree
+  // (bench/support/embree_baseline.hpp) is traced this way.
   std::function<BuildTree(std::span<const Aabb>, std::span<const std::uint32_t>)> custom_builder;
 };
 
@@ -157,10 +158,10 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
                                 std::string name = "bvh", const AccelConfig& accel_config = {});
 
 // The options of the SAH-built structures ("bvh", "bvh-packet"), and the
-// BvhConfig a structure's resolved options give (for structures built on
-// the BVH, bvh_mixed.hpp).
+// BvhConfig a structure's resolved options (make_accel: every declared
+// option present) give (for structures built on the BVH, bvh_mixed.hpp).
 const std::vector<OptionSpec>& bvh_sah_options();
-BvhConfig resolve_bvh_config(const StructureSpec& structure, const AccelConfig& config);
+BvhConfig bvh_config_from(const AccelOptions& options);
 
 // The stats of a BVH built since `start` over validated `geometry`, and the
 // defines of its traversal kernels (bvh and bvh-mixed).
@@ -176,7 +177,8 @@ const StructureSpec& bvh_packet_structure();
 
 // The registered structures: "bvh" (binned SAH), "bvh-ploc" (PLOC) and
 // "bvh-packet" (binned SAH, BvhTraversal::packet), configured by
-// config.options (defaults: the config structs' defaults).
+// config.options as make_accel resolved them (the registry's factories:
+// every declared option present, defaults filled in).
 std::unique_ptr<Accel> make_bvh_sah(const Device& device, const Geometry& geometry, const AccelConfig& config);
 std::unique_ptr<Accel> make_bvh_ploc(const Device& device, const Geometry& geometry, const AccelConfig& config);
 std::unique_ptr<Accel> make_bvh_packet(const Device& device, const Geometry& geometry, const AccelConfig& config);

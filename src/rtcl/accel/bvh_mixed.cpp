@@ -74,8 +74,8 @@ const StructureSpec& bvh_mixed_structure() {
 
 std::unique_ptr<Accel> make_bvh_mixed(const Device& device, const Geometry& geometry, const AccelConfig& config) {
   auto start = std::chrono::steady_clock::now();
-  BvhConfig bvh_config = resolve_bvh_config(bvh_mixed_structure(), config);
-  AccelOptions o = resolve_options(bvh_mixed_structure(), config.options, "--accel bvh-mixed");
+  BvhConfig bvh_config = bvh_config_from(config.options);
+  const AccelOptions& o = config.options;
   VolumeCosts costs;
   costs.sphere = static_cast<float>(o.real("sphere_cost"));
   costs.kdop = static_cast<float>(o.real("kdop_cost"));

@@ -465,7 +465,7 @@ const StructureSpec& grid_structure() {
 }
 
 std::unique_ptr<Accel> make_grid_accel(const Device& device, const Geometry& geometry, const AccelConfig& config) {
-  AccelOptions o = resolve_options(grid_structure(), config.options, "--accel grid");
+  const AccelOptions& o = config.options;
   GridConfig grid;
   grid.lambda = o.real("lambda");
   grid.resolution = o.resolution("res");

@@ -610,19 +610,6 @@ std::unique_ptr<KdBuildNode> build_tree(const KdPrimitives& prims, const KdTreeC
   return root;
 }
 
-void check_config(const KdTreeConfig& c) {
-  if (c.depth < 0 || c.depth > kKdMaxDepth)
-    throw Error("kdtree: depth must be in [0, " + std::to_string(kKdMaxDepth) + "] (the traversal stack), got " +
-                std::to_string(c.depth));
-  if (!(c.traversal_cost > 0.0) || !std::isfinite(c.traversal_cost))
-    throw Error("kdtree: ct must be > 0 (got " + std::to_string(c.traversal_cost) + ")");
-  if (!(c.intersection_cost > 0.0) || !std::isfinite(c.intersection_cost))
-    throw Error("kdtree: ci must be > 0 (got " + std::to_string(c.intersection_cost) + ")");
-  if (!(c.empty_bonus >= 0.0 && c.empty_bonus < 1.0))
-    throw Error("kdtree: empty must be in [0, 1) (got " + std::to_string(c.empty_bonus) + ")");
-  if (c.batch < 1 || c.batch > 8) throw Error("kdtree: batch must be in [1, 8] (got " + std::to_string(c.batch) + ")");
-}
-
 }  // namespace
 
 int kdtree_depth(const KdTreeConfig& config, std::size_t primitives) {
@@ -632,7 +619,6 @@ int kdtree_depth(const KdTreeConfig& config, std::size_t primitives) {
 }
 
 KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config) {
-  check_config(config);
   KdPrimitives prims = kd_primitives(geometry, "kdtree", config.max_alloc_bytes);
   int depth = kdtree_depth(config, prims.size());
   unsigned threads = config.thread_count ? config.thread_count : std::max(1u, std::thread::hardware_concurrency());
@@ -650,11 +636,12 @@ KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config) {
 
 namespace {
 
-// The build options; with the single-ray kernel's occlusion queries
-// (`kdtree`) also occluder_run, which the packet kernel does not have.
+// The build options, the one declaration of their defaults (KdTreeConfig's)
+// and ranges; with the single-ray kernel's occlusion queries (`kdtree`)
+// also occluder_run, which the packet kernel does not have.
 std::vector<OptionSpec> kdtree_options(bool occluder_runs) {
   static const KdTreeConfig d;
-  std::vector<OptionSpec> options = {{"depth", OptionType::integer, std::int64_t{0}, 0, kKdMaxDepth, false,
+  std::vector<OptionSpec> options = {{"depth", OptionType::integer, std::int64_t{d.depth}, 0, kKdMaxDepth, false,
            "deepest leaf in splits, at most the traversal stack; 0: round(8 + 1.3 log2 N)"},
           {"ct", OptionType::real, d.traversal_cost, 0, 1e6, true,
            "SAH cost of one node step: higher makes shallower trees with larger leaves"},
@@ -673,7 +660,7 @@ std::vector<OptionSpec> kdtree_options(bool occluder_runs) {
 
 std::unique_ptr<Accel> make_kdtree_from(const StructureSpec& spec, KdTraversal traversal, const Device& device,
                                         const Geometry& geometry, const AccelConfig& config) {
-  AccelOptions o = resolve_options(spec, config.options, "--accel " + spec.name);
+  const AccelOptions& o = config.options;
   KdTreeConfig kd;
   kd.depth = static_cast<int>(o.integer("depth"));
   kd.traversal_cost = o.real("ct");

@@ -31,7 +31,8 @@ struct KdTreeConfig {
   // build (README, "BSP and kd-tree": bench sweep/<scene>/<kind>/kdtree/...).
   double traversal_cost = 30.0;
   double intersection_cost = 20.0;
-  // The empty-space bonus in [0, 1) (Wald & Havran's 0.8 factor = 0.2):
+  // The empty-space bonus (Wald & Havran's 0.8 factor = 0.2; range: the
+  // `empty` option, kdtree_structure()):
   // favours splits that cut off empty space, which the interval traversal
   // skips for the price of one node.
   double empty_bonus = 0.2;
@@ -64,8 +65,10 @@ struct KdTreeConfig {
 // The depth the build uses for `primitives` stored primitives.
 int kdtree_depth(const KdTreeConfig& config, std::size_t primitives);
 
-// Builds over the stored primitives of validated geometry. Throws Error
-// naming the option for a bad config or a tree too large for the device.
+// Builds over the stored primitives of validated geometry. The config's
+// options hold values in the ranges kdtree_structure() declares (make_accel
+// checks them there, once). Throws Error for a tree too large for the
+// device.
 KdTree build_kdtree(const Geometry& geometry, const KdTreeConfig& config = {});
 
 // Its registry entries: depth, ct (traversal_cost), ci (intersection_cost),

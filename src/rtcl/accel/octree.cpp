@@ -209,7 +209,7 @@ const StructureSpec& octree_structure() {
 }
 
 std::unique_ptr<Accel> make_octree_accel(const Device& device, const Geometry& geometry, const AccelConfig& config) {
-  AccelOptions o = resolve_options(octree_structure(), config.options, "--accel octree");
+  const AccelOptions& o = config.options;
   OctreeConfig tree;
   read_octree_options(o, &tree);
   tree.buckets = o.boolean("buckets");

@@ -153,7 +153,7 @@ const StructureSpec& octree_ptr_structure() {
 
 std::unique_ptr<Accel> make_octree_ptr_accel(const Device& device, const Geometry& geometry,
                                              const AccelConfig& config) {
-  AccelOptions o = resolve_options(octree_ptr_structure(), config.options, "--accel octree-ptr");
+  const AccelOptions& o = config.options;
   OctreePtrConfig tree;
   read_octree_options(o, &tree);
   return make_octree_ptr(device, geometry, tree, config);

@@ -103,7 +103,7 @@ const StructureSpec& octree_r_structure() {
 
 std::unique_ptr<Accel> make_octree_r_accel(const Device& device, const Geometry& geometry,
                                            const AccelConfig& config) {
-  AccelOptions o = resolve_options(octree_r_structure(), config.options, "--accel octree-r");
+  const AccelOptions& o = config.options;
   OctreeRConfig tree;
   read_octree_options(o, &tree);
   tree.bins = static_cast<int>(o.integer("bins"));

@@ -38,7 +38,12 @@ std::string option_list(const StructureSpec& s) {
   if (s.options.empty()) return s.name + " has no options";
   std::string list;
   for (const OptionSpec& o : s.options) list += (list.empty() ? "" : ", ") + o.name;
-  return "options of " + s.name + ": " + list;
+  return "options: " + list;
+}
+
+// "unknown option foo of grid (options: lambda, res, ...)".
+std::string unknown_option(const StructureSpec& s, const std::string& option) {
+  return "unknown option " + option + " of " + s.name + " (" + option_list(s) + ")";
 }
 
 // Checks a typed value against the declaration (type and range).
@@ -200,7 +205,7 @@ AccelOptions resolve_options(const StructureSpec& structure, const AccelOptions&
   AccelOptions out;
   for (const auto& [name, value] : given.values()) {
     const OptionSpec* spec = structure.find(name);
-    if (!spec) throw Error(context + ": unknown option " + name + " (" + option_list(structure) + ")");
+    if (!spec) throw Error(context + ": " + unknown_option(structure, name));
     check_value(*spec, value, context);
     out.set(name, spec->type == OptionType::real && std::holds_alternative<std::int64_t>(value)
                       ? OptionValue(static_cast<double>(std::get<std::int64_t>(value)))
@@ -212,7 +217,7 @@ AccelOptions resolve_options(const StructureSpec& structure, const AccelOptions&
 }
 
 AccelSpec parse_accel_spec(std::string_view text, const std::string& given_context) {
-  std::string context = given_context.empty() ? "--accel " + std::string(text) : given_context;
+  std::string context = given_context.empty() ? "accel \"" + std::string(text) + "\"" : given_context;
   std::size_t colon = text.find(':');
   AccelSpec out;
   out.name = std::string(text.substr(0, colon));
@@ -220,9 +225,10 @@ AccelSpec parse_accel_spec(std::string_view text, const std::string& given_conte
   try {
     found = &structure_spec(out.name);
   } catch (const Error& e) {
-    if (given_context.empty()) throw;
+    // structure_spec's "accel "NAME": PROBLEM", under this context.
     std::string what = e.what();
-    throw Error(context + what.substr(what.find(':')));
+    std::string own = "accel \"" + out.name + "\"";
+    throw Error(context + (what.rfind(own, 0) == 0 ? what.substr(own.size()) : ": " + what));
   }
   const StructureSpec& structure = *found;
   if (colon == std::string_view::npos) return out;
@@ -237,7 +243,7 @@ AccelSpec parse_accel_spec(std::string_view text, const std::string& given_conte
       throw Error(context + ": expected key=value, got '" + std::string(item) + "'");
     std::string key(item.substr(0, eq));
     const OptionSpec* spec = structure.find(key);
-    if (!spec) throw Error(context + ": unknown option " + key + " (" + option_list(structure) + ")");
+    if (!spec) throw Error(context + ": " + unknown_option(structure, key));
     if (out.options.has(key)) throw Error(context + ": option " + key + " given twice");
     out.options.set(key, parse_option_value(*spec, item.substr(eq + 1), context));
   }

@@ -17,7 +17,7 @@ Precision parse_precision(std::string_view name) {
   const auto& names = precision_names();
   for (std::size_t i = 0; i < names.size(); ++i)
     if (names[i] == name) return static_cast<Precision>(i);
-  throw Error("--precision " + std::string(name) + ": unknown precision level (known: fast, robust, exact)");
+  throw Error("precision \"" + std::string(name) + "\": unknown precision level (known: fast, robust, exact)");
 }
 
 std::string precision_unsupported(const DeviceInfo& device, Precision precision) {
@@ -28,7 +28,7 @@ std::string precision_unsupported(const DeviceInfo& device, Precision precision)
 
 void require_precision(const DeviceInfo& device, Precision precision) {
   std::string why = precision_unsupported(device, precision);
-  if (!why.empty()) throw Error("--precision " + std::string(precision_name(precision)) + ": " + why);
+  if (!why.empty()) throw Error("precision \"" + std::string(precision_name(precision)) + "\": " + why);
 }
 
 std::vector<std::string> precision_build_options(Precision precision) {

@@ -66,20 +66,25 @@ const StructureSpec& structure_spec(std::string_view name) {
     if (entry.spec.name == name) return entry.spec;
   std::string known;
   for (const Entry& entry : registry()) known += (known.empty() ? "" : ", ") + entry.spec.name;
-  throw Error("--accel " + std::string(name) + ": unknown acceleration structure (known: " + known + ")");
+  throw Error("accel \"" + std::string(name) + "\": unknown acceleration structure (known: " + known + ")");
 }
 
+// The options are parsed, checked and completed with their defaults here,
+// once: a factory receives every declared option of its structure.
 std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry,
                                   const AccelConfig& config) {
-  AccelSpec spec = parse_accel_spec(name);
+  const std::string context = "make_accel name \"" + std::string(name) + "\"";
+  AccelSpec spec = parse_accel_spec(name, context);
   AccelConfig full = config;
   full.options = spec.options;
   for (const auto& [option, value] : config.options.values()) full.options.set(option, value);
-  full.options = resolve_options(structure_spec(spec.name), full.options, "--accel " + std::string(name));
-  require_precision(device.info(), config.precision);  // before the build (the Accel base checks again for direct factories)
-  for (const Entry& entry : registry())
-    if (entry.spec.name == spec.name) return entry.make(device, geometry, full);
-  throw Error("internal: structure " + spec.name + " has no factory");
+  const Entry* entry = nullptr;
+  for (const Entry& e : registry())
+    if (e.spec.name == spec.name) entry = &e;
+  if (!entry) throw Error("internal: structure " + spec.name + " has no factory");
+  full.options = resolve_options(entry->spec, full.options, context);
+  require_precision(device.info(), config.precision);  // before the build; the Accel base checks it for bvh-motion
+  return entry->make(device, geometry, full);
 }
 
 }  // namespace rtcl

@@ -18,8 +18,8 @@ namespace rtcl {
 // packet as a work-item of its own to fill its lanes).
 inline constexpr std::uint32_t kCpuOccluderRun = 16;
 std::size_t occluder_run_for(std::uint32_t requested, const DeviceInfo& device);
-// That option, as such structures declare it.
-OptionSpec occluder_run_option();
+// That option: one declaration that such structures list.
+const OptionSpec& occluder_run_option();
 
 // Whether a structure's packet kernel serves its Coherence::coherent calls
 // (`bvh`, `bvh-ploc` and `kdtree`; `bvh-packet` and `kdtree-packet` take it

@@ -33,26 +33,36 @@ std::string read_kernel_file(const std::string& path) {
   return std::string(it->second);
 }
 
-// Whether kernels/`path` exists (embedded, or under RTCL_KERNEL_DIR).
 bool kernel_file_exists(const std::string& path) {
   if (const char* dir = std::getenv("RTCL_KERNEL_DIR"); dir && *dir)
-    return static_cast<bool>(std::ifstream(std::string(dir) + "/" + path));
+    return std::ifstream(std::string(dir) + "/" + path).good();
   return embedded_kernels().count(path) > 0;
 }
 
-// An #include "name" of file `from`: as a C preprocessor finds it, next to
-// `from` first ("query_layouts.h" in shared/layouts.h), else from kernels/.
-std::string resolve_include(const std::string& from, const std::string& name) {
+// The file `#include "name"` in `from` names: beside `from` when there is
+// one (as a C preprocessor looks first), else relative to kernels/.
+std::string included_path(const std::string& from, const std::string& name) {
   std::size_t slash = from.rfind('/');
-  if (slash == std::string::npos) return name;
-  std::string beside = from.substr(0, slash + 1) + name;
-  return kernel_file_exists(beside) ? beside : name;
+  if (slash != std::string::npos) {
+    std::string beside = from.substr(0, slash + 1) + name;
+    if (kernel_file_exists(beside)) return beside;
+  }
+  return name;
 }
 
+void inline_includes(const std::string& path, const std::string& text, std::set<std::string>& seen,
+                     std::string& out);
+
 void inline_includes(const std::string& path, std::set<std::string>& seen, std::string& out) {
-  if (!seen.insert(path).second) return;
+  if (seen.count(path)) return;
+  inline_includes(path, read_kernel_file(path), seen, out);
+}
+
+void inline_includes(const std::string& path, const std::string& text, std::set<std::string>& seen,
+                     std::string& out) {
+  seen.insert(path);
   static const std::regex include_line(R"(^\s*#\s*include\s*"([^"]+)\"\s*$)");
-  std::istringstream lines(read_kernel_file(path));
+  std::istringstream lines(text);
   std::string line;
   int number = 0;
   out += "#line 1 \"" + path + "\"\n";
@@ -60,7 +70,7 @@ void inline_includes(const std::string& path, std::set<std::string>& seen, std::
     ++number;
     std::smatch m;
     if (std::regex_match(line, m, include_line)) {
-      inline_includes(resolve_include(path, m[1].str()), seen, out);
+      inline_includes(included_path(path, m[1].str()), seen, out);
       out += "#line " + std::to_string(number + 1) + " \"" + path + "\"\n";
     } else {
       out += line;
@@ -75,6 +85,13 @@ std::string kernel_source(const std::string& path) {
   std::set<std::string> seen;
   std::string out;
   inline_includes(path, seen, out);
+  return out;
+}
+
+std::string kernel_source(const std::string& path, const std::string& text) {
+  std::set<std::string> seen;
+  std::string out;
+  inline_includes(path, text, seen, out);
   return out;
 }
 

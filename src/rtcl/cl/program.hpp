@@ -11,6 +11,9 @@ namespace rtcl {
 // markers so that build logs name the original file and line.
 // Throws Error naming the file when it does not exist.
 std::string kernel_source(const std::string& path);
+// The same for a kernel file that is not the library's (bench/kernels/):
+// `text` read as `path`, its includes from the library's kernels.
+std::string kernel_source(const std::string& path, const std::string& text);
 
 // A build log with the compiler's positions in the assembled source
 // ("<kernel>:N:", as NVIDIA's OpenCL compiler writes them: it ignores #line)

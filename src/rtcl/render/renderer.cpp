@@ -115,8 +115,8 @@ Renderer::Renderer(const Device& device, const Scene& scene, std::string_view ac
     s_->shading = upload_scene(device, s_->scene, s_->flat);
   } else {
     if (parse_accel_spec(accel_name).name != "bvh")
-      throw Error("--accel " + std::string(accel_name) + ": " + scene.source +
-                  " has moving objects, which only the motion BVH traces (use --accel bvh)");
+      throw Error("Renderer accel \"" + std::string(accel_name) + "\": " + scene.source +
+                  " has moving objects, which only the motion BVH traces (accel bvh)");
     const double open = scene.camera.shutter_open, close = scene.camera.shutter_close;
     check_motion(scene, open, close);
     Scene at_open = scene_at(scene, open), at_close = scene_at(scene, close);

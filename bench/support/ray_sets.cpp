@@ -1,4 +1,4 @@
-#include "rtcl/bench/ray_sets.hpp"
+#include "bench/support/ray_sets.hpp"
 
 #include <algorithm>
 #include <cmath>

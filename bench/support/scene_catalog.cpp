@@ -1,4 +1,4 @@
-#include "rtcl/bench/scene_catalog.hpp"
+#include "bench/support/scene_catalog.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "rtcl/bench/embree_baseline.hpp"
+#include "bench/support/embree_baseline.hpp"
 
 #include <embree3/rtcore.h>
 

@@ -9,7 +9,7 @@
 
 #include <glm/glm.hpp>
 
-#include "rtcl/bench/scene_catalog.hpp"
+#include "bench/support/scene_catalog.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/geometry.hpp"
 

@@ -1,0 +1,47 @@
+// The library's errors name its API parameters (accel "TEXT", make_accel
+// name "TEXT", precision "NAME"); rtcl's name the flags a user typed
+// (--accel TEXT, --precision NAME). These wrappers check a flag's value
+// with the library and report a problem under the flag's name.
+#pragma once
+
+#include <string>
+#include <utility>
+
+#include "rtcl/accel_options.hpp"
+#include "rtcl/device.hpp"
+#include "rtcl/error.hpp"
+#include "rtcl/precision.hpp"
+
+namespace rtcl::cli {
+
+// parse_accel_spec under "--accel TEXT": "--accel grid:lambda=-1: lambda
+// must be > 0 and <= 1024".
+AccelSpec parse_accel_flag(const std::string& text);
+
+// parse_precision under "--precision NAME": "--precision precise: unknown
+// precision level (known: fast, robust, exact)".
+Precision parse_precision_flag(const std::string& name);
+
+// require_precision under "--precision NAME": "--precision exact: exact
+// needs double precision on the device (cl_khr_fp64), which DEVICE lacks".
+void require_precision_flag(const DeviceInfo& device, Precision precision);
+
+// When the library raised `e` about the structure `accel` (accel "TEXT",
+// make_accel name "TEXT", Renderer accel "TEXT"): the same problem under
+// "--accel TEXT"; else "".
+std::string accel_flag_message(const Error& e, const std::string& accel);
+
+// Runs `work`; a library error about the structure `accel` names --accel
+// instead (accel_flag_message); other errors pass unchanged.
+template <class Work>
+decltype(auto) naming_accel_flag(const std::string& accel, Work&& work) {
+  try {
+    return std::forward<Work>(work)();
+  } catch (const Error& e) {
+    std::string renamed = accel_flag_message(e, accel);
+    if (renamed.empty()) throw;
+    throw Error(renamed);
+  }
+}
+
+}  // namespace rtcl::cli
