@@ -59,6 +59,9 @@ struct Accel::State {
   // Per query (closest, any): the choice and its call in flight.
   std::array<SortChoice, 2> sort_choices;
   std::array<std::optional<PendingCall>, 2> pending;
+  // Host-array calls pack separate ray arrays here (HostBatches), kept
+  // between calls.
+  std::vector<unsigned char> staging;
   // Kernels of kernels/query/ by "file:kernel" (detail::AccelAccess::kernel).
   std::map<std::string, cl::Kernel> query_kernels;
 };
@@ -69,6 +72,8 @@ namespace detail {
 struct AccelAccess {
   static std::mutex& mutex(const Accel& accel) { return accel.state_->mutex; }
   static bool plain_bvh8(const Accel& accel) { return accel.plain_bvh8(); }
+  // Staging memory of host-array calls; call with mutex(accel) held.
+  static std::vector<unsigned char>& staging(const Accel& accel) { return accel.state_->staging; }
   // Kernel `kernel_name` of kernels/`file`, built with the structure's
   // defines plus `defines`, its structure arguments set from argument
   // `first_structure_arg` on (Accel::set_structure_args); built once per

@@ -82,7 +82,7 @@ void closest_points_on_host(const Accel& accel, const Points& points, std::span<
   check_points(points, call);
   HostBatches batches(accel.device(), points.size(), kPointBytes, sizeof(PointHit));
   std::lock_guard lock(detail::AccelAccess::mutex(accel));
-  batches.run([&](std::size_t first, std::size_t, void*) -> const void* { return points.xyz().data() + 3 * first; },
+  batches.run(points.xyz().data(),
               [&](const cl::Buffer& in, const cl::Buffer& result, std::size_t n, const std::vector<cl::Event>& wait) {
                 return enqueue_locked(accel, in, result, n, max_distance, wait);
               },

@@ -71,12 +71,8 @@ cl::Event enqueue_count(const Accel& accel, const cl::Buffer& rays, const cl::Bu
 // count on host arrays, arguments checked; mutex held.
 void count_locked(const Accel& accel, const Rays& rays, std::uint32_t* counts) {
   HostBatches batches(accel.device(), rays.size(), sizeof(Ray), sizeof(std::uint32_t));
-  batches.run(
-      [&](std::size_t first, std::size_t n, void* staging) -> const void* {
-        if (rays.are_records()) return rays.records().data() + first;
-        rays.pack(first, std::span<Ray>(static_cast<Ray*>(staging), n));
-        return staging;
-      },
+  run_rays(
+      batches, rays, AccelAccess::staging(accel),
       [&](const cl::Buffer& in, const cl::Buffer& out, std::size_t n, const std::vector<cl::Event>& wait) {
         return enqueue_count(accel, in, out, n, wait);
       },
@@ -160,12 +156,16 @@ AllHits Accel::all_hits(const Rays& rays, std::uint32_t max_hits_per_ray) const 
                     std::to_string(max_hits));
       if (hits > 0) {
         const std::size_t n = end - first;
-        staging.resize(n);
-        rays.pack(first, staging);
+        const Ray* chunk = rays.are_records() ? rays.records().data() + first : nullptr;
+        if (!chunk) {
+          staging.resize(n);
+          rays.pack(first, staging);
+          chunk = staging.data();
+        }
         offsets.resize(n + 1);
         for (std::size_t k = 0; k <= n; ++k)
           offsets[k] = static_cast<std::uint32_t>(result.offsets[first + k] - result.offsets[first]);
-        cl::Buffer ray_buffer = device_.upload(staging.data(), n * sizeof(Ray), "all_hits rays");
+        cl::Buffer ray_buffer = device_.upload(chunk, n * sizeof(Ray), "all_hits rays");
         cl::Buffer offset_buffer =
             device_.upload(offsets.data(), offsets.size() * sizeof(std::uint32_t), "all_hits offsets");
         cl::Buffer hit_buffer = device_.allocate(hits * sizeof(Hit), "all_hits hits");

@@ -19,83 +19,123 @@ bool copy_forced() {
 }  // namespace
 
 HostBatches::HostBatches(const Device& device, std::size_t count, std::size_t in_item_bytes,
-                         std::size_t out_item_bytes, std::size_t max_batch_items)
+                         std::size_t out_item_bytes)
     : device_(device),
       count_(count),
       in_bytes_(in_item_bytes),
       out_bytes_(out_item_bytes),
       shared_memory_(device.info().type == "cpu" && !copy_forced()) {
   const std::size_t largest = std::max(in_item_bytes, out_item_bytes);
-  std::size_t fit = device.info().max_alloc_bytes / largest;
-  if (fit == 0)
+  if (device.info().max_alloc_bytes < largest)
     throw Error("device " + device.info().name + " allows buffers of " + std::to_string(device.info().max_alloc_bytes) +
                 " bytes, fewer than one query record of " + std::to_string(largest));
-  batch_items_ = std::min(fit, max_batch_items ? max_batch_items : fit);
-  batch_items_ = std::max<std::size_t>(1, std::min(batch_items_, count));
 }
 
-void HostBatches::run(const Input& input, const Enqueue& enqueue, void* output) const {
+std::size_t HostBatches::batch_limit(std::size_t wanted) const {
+  const std::size_t fit = device_.info().max_alloc_bytes / std::max(in_bytes_, out_bytes_);
+  return std::max<std::size_t>(1, std::min({fit, wanted, count_}));
+}
+
+void HostBatches::run(const void* in, const Enqueue& enqueue, void* output) const {
+  const auto* bytes = static_cast<const unsigned char*>(in);
+  run_batches(batch_limit(kDefaultMaxBatch), false,
+              [&](std::size_t first, std::size_t, std::size_t) { return bytes + first * in_bytes_; }, enqueue, output);
+}
+
+void HostBatches::run(const Pack& pack, std::vector<unsigned char>& staging, const Enqueue& enqueue,
+                      void* output) const {
+  const std::size_t batch = batch_limit(kPackedBatch);
+  const std::size_t slot_bytes = batch * in_bytes_;
+  if (count_ > 0 && staging.size() < 2 * slot_bytes) staging.resize(2 * slot_bytes);
+  run_batches(batch, true,
+              [&](std::size_t first, std::size_t n, std::size_t slot) -> const void* {
+                unsigned char* to = staging.data() + slot * slot_bytes;
+                pack(first, n, to);
+                return to;
+              },
+              enqueue, output);
+}
+
+void HostBatches::run_batches(std::size_t batch, bool packed, const Source& source, const Enqueue& enqueue,
+                              void* output) const {
   if (count_ == 0) return;
   with_cl_errors([&] {
     try {
       if (shared_memory_)
-        run_shared(input, enqueue, output);
+        run_shared(batch, packed, source, enqueue, output);
       else
-        run_copied(input, enqueue, output);
+        run_copied(batch, source, enqueue, output);
     } catch (...) {
-      device_.queue().finish();  // no command may still write into the caller's arrays
+      device_.queue().finish();  // no command may still read or write the caller's arrays
       throw;
     }
   });
 }
 
-void HostBatches::run_shared(const Input& input, const Enqueue& enqueue, void* output) const {
+void HostBatches::run_shared(std::size_t batch, bool packed, const Source& source, const Enqueue& enqueue,
+                             void* output) const {
   const cl::Context& context = device_.context();
   cl::CommandQueue& queue = device_.queue();
-  std::vector<unsigned char> staging;
   auto* out = static_cast<unsigned char*>(output);
-  for (std::size_t first = 0; first < count_; first += batch_items_) {
-    const std::size_t n = std::min(batch_items_, count_ - first);
-    if (staging.empty()) staging.resize(batch_items_ * in_bytes_);
-    const void* src = input(first, n, staging.data());
+  struct Mapped {
+    cl::Buffer buffer;
+    void* pointer;
+    unsigned char* target;
+    std::size_t bytes;
+    cl::Event ready;
+  };
+  std::vector<Mapped> maps;
+  cl::Event slot_done[2];  // the kernel that last read each half of the staging memory
+  std::size_t b = 0;
+  for (std::size_t first = 0; first < count_; first += batch, ++b) {
+    const std::size_t n = std::min(batch, count_ - first);
+    const std::size_t slot = b % 2;
+    if (packed && slot_done[slot]()) slot_done[slot].wait();
+    const void* src = source(first, n, slot);
     cl::Buffer in(context, CL_MEM_READ_ONLY | CL_MEM_USE_HOST_PTR, n * in_bytes_, const_cast<void*>(src));
     cl::Buffer result(context, CL_MEM_WRITE_ONLY | CL_MEM_USE_HOST_PTR, n * out_bytes_, out + first * out_bytes_);
     cl::Event done = enqueue(in, result, n, {});
+    slot_done[slot] = done;
     // Mapping makes the device's writes visible in the caller's array (no
     // copy where the device uses the host pointer itself).
     std::vector<cl::Event> after{done};
-    void* mapped = queue.enqueueMapBuffer(result, CL_TRUE, CL_MAP_READ, 0, n * out_bytes_, &after);
-    if (mapped != out + first * out_bytes_) std::memcpy(out + first * out_bytes_, mapped, n * out_bytes_);
-    cl::Event unmapped;
-    queue.enqueueUnmapMemObject(result, mapped, nullptr, &unmapped);
-    unmapped.wait();
+    Mapped map{result, nullptr, out + first * out_bytes_, n * out_bytes_, {}};
+    map.pointer = queue.enqueueMapBuffer(result, CL_FALSE, CL_MAP_READ, 0, map.bytes, &after, &map.ready);
+    maps.push_back(std::move(map));
+    queue.flush();
   }
+  std::vector<cl::Event> unmapped(maps.size());
+  for (std::size_t i = 0; i < maps.size(); ++i) {
+    maps[i].ready.wait();
+    if (maps[i].pointer != maps[i].target) std::memcpy(maps[i].target, maps[i].pointer, maps[i].bytes);
+    queue.enqueueUnmapMemObject(maps[i].buffer, maps[i].pointer, nullptr, &unmapped[i]);
+  }
+  cl::Event::waitForEvents(unmapped);
 }
 
-void HostBatches::run_copied(const Input& input, const Enqueue& enqueue, void* output) const {
+void HostBatches::run_copied(std::size_t batch, const Source& source, const Enqueue& enqueue, void* output) const {
   cl::CommandQueue& queue = device_.queue();
   struct Slot {
     cl::Buffer in, out;
-    std::vector<unsigned char> staging;
     cl::Event uploaded, read_back;
   };
-  const std::size_t slots = count_ > batch_items_ ? 2 : 1;
+  const std::size_t slots = count_ > batch ? 2 : 1;
   std::vector<Slot> slot(slots);
   for (Slot& s : slot) {
-    s.in = device_.allocate(batch_items_ * in_bytes_, "query input batch", CL_MEM_READ_ONLY);
-    s.out = device_.allocate(batch_items_ * out_bytes_, "query output batch", CL_MEM_WRITE_ONLY);
+    s.in = device_.allocate(batch * in_bytes_, "query input batch", CL_MEM_READ_ONLY);
+    s.out = device_.allocate(batch * out_bytes_, "query output batch", CL_MEM_WRITE_ONLY);
   }
   auto* out = static_cast<unsigned char*>(output);
   std::size_t b = 0;
-  for (std::size_t first = 0; first < count_; first += batch_items_, ++b) {
-    const std::size_t n = std::min(batch_items_, count_ - first);
-    Slot& s = slot[b % slots];
+  for (std::size_t first = 0; first < count_; first += batch, ++b) {
+    const std::size_t n = std::min(batch, count_ - first);
+    const std::size_t k = b % slots;
+    Slot& s = slot[k];
     // The slot's previous upload must be done before its staging is
     // refilled, and its previous read-back before its buffers are reused
     // (the in-order queue orders the rest).
     if (s.uploaded()) s.uploaded.wait();
-    if (s.staging.empty()) s.staging.resize(batch_items_ * in_bytes_);
-    const void* src = input(first, n, s.staging.data());
+    const void* src = source(first, n, k);
     std::vector<cl::Event> before;
     if (s.read_back()) before.push_back(s.read_back);
     queue.enqueueWriteBuffer(s.in, CL_FALSE, 0, n * in_bytes_, src, &before, &s.uploaded);
@@ -106,6 +146,16 @@ void HostBatches::run_copied(const Input& input, const Enqueue& enqueue, void* o
   }
   for (Slot& s : slot)
     if (s.read_back()) s.read_back.wait();
+}
+
+void run_rays(const HostBatches& batches, const Rays& rays, std::vector<unsigned char>& staging,
+              const HostBatches::Enqueue& enqueue, void* output) {
+  if (rays.are_records()) {
+    batches.run(rays.records().data(), enqueue, output);
+    return;
+  }
+  batches.run([&](std::size_t first, std::size_t n, void* to) { rays.pack(first, std::span<Ray>(static_cast<Ray*>(to), n)); },
+              staging, enqueue, output);
 }
 
 }  // namespace rtcl

@@ -18,12 +18,8 @@ void Accel::trace(Query query, const Rays& rays, std::span<Hit> hits, Coherence 
   if (rays.size() > 0 && !hits.data()) throw Error(std::string(call) + ": null hits array");
   HostBatches batches(device_, rays.size(), sizeof(Ray), sizeof(Hit));
   std::lock_guard lock(state_->mutex);
-  batches.run(
-      [&](std::size_t first, std::size_t n, void* staging) -> const void* {
-        if (rays.are_records()) return rays.records().data() + first;
-        rays.pack(first, std::span<Ray>(static_cast<Ray*>(staging), n));
-        return staging;
-      },
+  run_rays(
+      batches, rays, state_->staging,
       [&](const cl::Buffer& in, const cl::Buffer& out, std::size_t n, const std::vector<cl::Event>& wait) {
         return trace_locked(query, in, out, n, wait, coherence);
       },
