@@ -51,7 +51,10 @@ cl::Event enqueue_locked(const Accel& accel, const cl::Buffer& points, const cl:
       device.queue().enqueueMarkerWithWaitList(&wait, &done);
       return done;
     }
-    cl::Kernel& kernel = detail::AccelAccess::kernel(accel, kFile, kKernel, {}, kFirstStructureArg);
+    // Built at the robust level whatever the structure's: without
+    // -cl-fast-relaxed-math, so that the pruning's rounding margin holds.
+    cl::Kernel& kernel =
+        detail::AccelAccess::kernel(accel, kFile, kKernel, {}, kFirstStructureArg, Precision::robust);
     kernel.setArg(0, points);
     kernel.setArg(1, out);
     kernel.setArg(2, static_cast<cl_uint>(count));
