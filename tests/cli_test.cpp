@@ -274,7 +274,7 @@ TEST(CliErrors, UnknownAccelAndDevice) {
     return run_cli(in.dir, args);
   };
   expect_usage_error(with({"--accel", "octopus"}), "--accel: unknown acceleration structure 'octopus' (known: brute");
-  expect_failure(with({"--device", "no-such-device-name"}), "--device 'no-such-device-name': no device name matches",
+  expect_failure(with({"--device", "no-such-device-name"}), "--device no-such-device-name: no device name matches",
                  in.dir, "out.hits");
   expect_failure(with({"--device", "99"}), "--device 99: no such device", in.dir, "out.hits");
 }

@@ -35,7 +35,7 @@ TEST(Showcase, HasEveryEffect) {
   Renderer renderer(test_device(), s, "bvh");
   for (const char* d : {"RTCL_HAS_AREA_LIGHTS", "RTCL_HAS_GLOSSY", "RTCL_HAS_REFRACTION", "RTCL_HAS_MOTION"})
     EXPECT_TRUE(has(renderer.defines(), d)) << d;
-  EXPECT_NE(error_of([] { builtin_scene("nothing"); }).find("--builtin nothing"), std::string::npos);
+  EXPECT_NE(error_of([] { builtin_scene("nothing"); }).find("builtin_scene name \"nothing\": unknown built-in scene"), std::string::npos);
 }
 
 // The thresholds of distributed_test.cpp (float rounding 1e-3 where the ray

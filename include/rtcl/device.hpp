@@ -34,8 +34,10 @@ class Device {
  public:
   // selector: "" uses $RTCL_DEVICE when set, else device 0; a number selects
   // by list_devices() index; anything else is a case-insensitive substring of
-  // "platform name device name". Throws Error naming the selector when
-  // nothing matches or no device exists.
+  // "platform name device name". Throws Error naming the selector
+  // (Device::open selector "99": no such device ...; RTCL_DEVICE "99": ...
+  // when it came from the environment) when nothing matches or no device
+  // exists.
   static Device open(std::string_view selector = {});
 
   // Uses a context, device and queue the caller already has (retained, not

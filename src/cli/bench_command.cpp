@@ -399,7 +399,7 @@ void run_bench(const BenchOptions& options) {
   if (infos.empty()) throw Error("no OpenCL device found (`rtcl devices` lists them)");
   std::vector<Device> devices;
   if (!options.device.empty()) {
-    devices.push_back(Device::open(options.device));
+    devices.push_back(open_device_flag(options.device));
   } else {
     for (const DeviceInfo& info : infos) devices.push_back(Device::open(std::to_string(info.index)));
   }

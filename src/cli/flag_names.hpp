@@ -11,6 +11,7 @@
 #include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/precision.hpp"
+#include "rtcl/scene/scene.hpp"
 
 namespace rtcl::cli {
 
@@ -25,6 +26,15 @@ Precision parse_precision_flag(const std::string& name);
 // require_precision under "--precision NAME": "--precision exact: exact
 // needs double precision on the device (cl_khr_fp64), which DEVICE lacks".
 void require_precision_flag(const DeviceInfo& device, Precision precision);
+
+// Device::open(selector) under "--device SELECTOR": "--device 99: no such
+// device (there are 1; see `rtcl devices`)". RTCL_DEVICE's errors (an
+// empty selector) pass unchanged.
+Device open_device_flag(const std::string& selector);
+
+// builtin_scene(name) under "--builtin NAME": "--builtin x: unknown
+// built-in scene (known: default, showcase)".
+Scene builtin_scene_flag(const std::string& name);
 
 // When the library raised `e` about the structure `accel` (accel "TEXT",
 // make_accel name "TEXT", Renderer accel "TEXT"): the same problem under

@@ -87,7 +87,7 @@ void run_beam(const RenderOptions& o) {
   beam::check_beam_scene(scene);
   check_image_path(o.output);
   RenderPlan plan = plan_render(o, scene);
-  Device device = Device::open(o.device);
+  Device device = open_device_flag(o.device);
   beam::BeamSettings bs;
   bs.width = plan.settings.width;
   bs.height = plan.settings.height;
@@ -150,7 +150,7 @@ void run(const RenderOptions& o) {
   Scene scene = load_render_scene(o);
   RenderPlan plan = plan_render(o, scene);
   RenderUnits units = plan_units(o, scene, plan.settings.spp);  // checks the output paths before the long work
-  Device device = Device::open(o.device);
+  Device device = open_device_flag(o.device);
   require_precision_flag(device.info(), plan.config.precision);
   std::unique_ptr<Renderer> renderer;
   for (const RenderUnit& unit : units.units) {
@@ -182,7 +182,7 @@ void run(const RenderOptions& o) {
 Scene read_render_scene(const RenderOptions& o) {
   if (!o.scene.empty() && !o.builtin.empty())
     throw Error("--builtin " + o.builtin + ": give a scene file or a built-in scene, not both (scene file " + o.scene + ")");
-  return o.scene.empty() ? builtin_scene(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
+  return o.scene.empty() ? builtin_scene_flag(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
 }
 
 Scene load_render_scene(const RenderOptions& o) {

@@ -99,7 +99,7 @@ void run_trace(const TraceOptions& options) {
                  options.mesh.c_str(), report.zero_area_triangles, report.zero_area_triangles == 1 ? "" : "s");
   std::vector<Ray> rays = read_rays(options.rays);
 
-  Device device = Device::open(options.device);
+  Device device = open_device_flag(options.device);
   const DeviceInfo& info = device.info();
   require_precision_flag(info, config.precision);
   std::printf("device: [%zu] %s (%s)\n", info.index, info.name.c_str(), info.platform.c_str());

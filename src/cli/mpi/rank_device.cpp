@@ -2,12 +2,13 @@
 
 #include <vector>
 
+#include "flag_names.hpp"
 #include "rtcl/error.hpp"
 
 namespace rtcl::cli {
 
 Device open_rank_device(const std::string& selector, int local_rank) {
-  if (!selector.empty()) return Device::open(selector);
+  if (!selector.empty()) return open_device_flag(selector);
   std::vector<DeviceInfo> infos = list_devices();
   if (infos.empty()) throw Error("no OpenCL device found (`rtcl devices` lists them)");
   return Device::open(std::to_string(infos[static_cast<std::size_t>(local_rank) % infos.size()].index));

@@ -100,7 +100,7 @@ Device::Device(std::shared_ptr<State> state) : state_(std::move(state)) {}
 Device Device::open(std::string_view selector_in) {
   return with_cl_errors([&] {
     std::string selector(selector_in);
-    std::string origin = "--device";
+    std::string origin = "Device::open selector";
     if (selector.empty()) {
       if (const char* env = std::getenv("RTCL_DEVICE"); env && *env) {
         selector = env;
@@ -117,7 +117,7 @@ Device Device::open(std::string_view selector_in) {
     } else if (std::all_of(selector.begin(), selector.end(), [](unsigned char c) { return std::isdigit(c); })) {
       chosen = std::stoul(selector);
       if (chosen >= devices.size())
-        throw Error(origin + " " + selector + ": no such device (there are " + std::to_string(devices.size()) +
+        throw Error(origin + " \"" + selector + "\": no such device (there are " + std::to_string(devices.size()) +
                     "; see `rtcl devices`)");
     } else {
       for (std::size_t i = 0; i < devices.size() && chosen == devices.size(); ++i) {
@@ -125,7 +125,7 @@ Device Device::open(std::string_view selector_in) {
         if (lower(info.platform + " " + info.name).find(lower(selector)) != std::string::npos) chosen = i;
       }
       if (chosen == devices.size())
-        throw Error(origin + " '" + selector + "': no device name matches (see `rtcl devices`)");
+        throw Error(origin + " \"" + selector + "\": no device name matches (see `rtcl devices`)");
     }
     auto state = std::make_shared<State>();
     state->info = describe(devices[chosen].first, devices[chosen].second, chosen);

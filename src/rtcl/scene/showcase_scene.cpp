@@ -66,7 +66,7 @@ Scene showcase_scene() {
 Scene builtin_scene(const std::string& name) {
   if (name == "default") return default_scene();
   if (name == "showcase") return showcase_scene();
-  throw Error("--builtin " + name + ": unknown built-in scene (known: default, showcase)");
+  throw Error("builtin_scene name \"" + name + "\": unknown built-in scene (known: default, showcase)");
 }
 
 }  // namespace rtcl

@@ -13,8 +13,8 @@ namespace rtcl {
 
 Scene showcase_scene();
 
-// The built-in scenes by name: "default", "showcase". Throws Error naming
-// --builtin and the known names for another.
+// The built-in scenes by name: "default", "showcase". Throws Error
+// (builtin_scene name "NAME": ...) naming the known names for another.
 Scene builtin_scene(const std::string& name);
 
 }  // namespace rtcl
