@@ -24,6 +24,7 @@
 #include "support/closest_point_reference.hpp"
 #include "support/error_of.hpp"
 #include "support/fixtures.hpp"
+#include "support/scoped_env.hpp"
 
 namespace rtcl::test {
 namespace {
@@ -33,15 +34,6 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // The structures that answer closest-point queries.
 const std::vector<std::string> kFamily{"bvh", "bvh-ploc", "bvh-packet"};
-
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) { ::setenv(name, value, 1); }
-  ~ScopedEnv() { ::unsetenv(name_); }
-
- private:
-  const char* name_;
-};
 
 Geometry scaled(Geometry g, float scale) {
   for (glm::vec3& v : g.vertices) v *= scale;

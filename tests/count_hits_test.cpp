@@ -24,6 +24,7 @@
 #include "support/error_of.hpp"
 #include "support/everywhere.hpp"
 #include "support/fixtures.hpp"
+#include "support/scoped_env.hpp"
 
 namespace rtcl::test {
 namespace {
@@ -36,15 +37,6 @@ constexpr float kNaN = everywhere::kNaN;
 const std::vector<std::string> kSupported = {"bvh", "bvh-ploc", "bvh-packet"};
 
 // Sets an environment variable for one scope.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) { ::setenv(name, value, 1); }
-  ~ScopedEnv() { ::unsetenv(name_); }
-
- private:
-  const char* name_;
-};
-
 // Every vertex and every edge midpoint (rounded to float) of a mesh.
 std::vector<glm::vec3> vertices_and_edge_midpoints(const Geometry& mesh) {
   std::vector<glm::vec3> points(mesh.vertices.begin(), mesh.vertices.end());

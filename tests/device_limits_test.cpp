@@ -16,20 +16,12 @@
 #include "support/cli_run.hpp"
 #include "support/error_of.hpp"
 #include "support/fixtures.hpp"
+#include "support/scoped_env.hpp"
 
 namespace rtcl::test {
 namespace {
 
 // Sets an environment variable for one scope.
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) { ::setenv(name, value, 1); }
-  ~ScopedEnv() { ::unsetenv(name_); }
-
- private:
-  const char* name_;
-};
-
 TEST(DeviceLimits, RefusalsGiveBothNumbers) {
   DeviceLimits limits{1000, 5000};
   EXPECT_EQ(error_of([&] { check_allocation(limits, 1000, 3999, "nodes", "dev"); }), "");

@@ -16,6 +16,7 @@
 #include "support/everywhere.hpp"
 #include "support/fixtures.hpp"
 #include "support/reference.hpp"
+#include "support/scoped_env.hpp"
 
 namespace rtcl::test {
 namespace {
@@ -23,17 +24,6 @@ namespace {
 using everywhere::kNaN;
 using everywhere::make_ray;
 using everywhere::query_name;
-
-class ScopedEnv {
- public:
-  ScopedEnv(const char* name, const char* value) : name_(name) { ::setenv(name, value, 1); }
-  ~ScopedEnv() { ::unsetenv(name_); }
-  ScopedEnv(const ScopedEnv&) = delete;
-  ScopedEnv& operator=(const ScopedEnv&) = delete;
-
- private:
-  const char* name_;
-};
 
 bool same_bits(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit)) == 0; }
 
