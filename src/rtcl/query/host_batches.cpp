@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <string>
 
 #include "rtcl/error.hpp"
@@ -120,29 +121,44 @@ void HostBatches::run_copied(std::size_t batch, const Source& source, const Enqu
     cl::Event uploaded, read_back;
   };
   const std::size_t slots = count_ > batch ? 2 : 1;
+  // Several batches: uploads and read-backs go through a queue of their
+  // own, so that the device may copy batch b + 1 in and batch b - 1 out
+  // while it traces batch b (the events order each batch's three steps).
+  cl::CommandQueue transfers = slots > 1 ? cl::CommandQueue(device_.context(), device_.device()) : queue;
   std::vector<Slot> slot(slots);
   for (Slot& s : slot) {
     s.in = device_.allocate(batch * in_bytes_, "query input batch", CL_MEM_READ_ONLY);
     s.out = device_.allocate(batch * out_bytes_, "query output batch", CL_MEM_WRITE_ONLY);
   }
   auto* out = static_cast<unsigned char*>(output);
+  struct FinishOnError {  // no copy may still touch the caller's arrays after a throw
+    cl::CommandQueue& queue;
+    ~FinishOnError() {
+      if (std::uncaught_exceptions() == 0) return;
+      try {
+        queue.finish();
+      } catch (...) {  // the error in flight is the one to report
+      }
+    }
+  } finish_transfers{transfers};
   std::size_t b = 0;
   for (std::size_t first = 0; first < count_; first += batch, ++b) {
     const std::size_t n = std::min(batch, count_ - first);
     const std::size_t k = b % slots;
     Slot& s = slot[k];
     // The slot's previous upload must be done before its staging is
-    // refilled, and its previous read-back before its buffers are reused
-    // (the in-order queue orders the rest).
+    // refilled, and its previous read-back before its buffers are reused.
     if (s.uploaded()) s.uploaded.wait();
     const void* src = source(first, n, k);
     std::vector<cl::Event> before;
     if (s.read_back()) before.push_back(s.read_back);
-    queue.enqueueWriteBuffer(s.in, CL_FALSE, 0, n * in_bytes_, src, &before, &s.uploaded);
+    transfers.enqueueWriteBuffer(s.in, CL_FALSE, 0, n * in_bytes_, src, &before, &s.uploaded);
+    transfers.flush();
     cl::Event traced = enqueue(s.in, s.out, n, {s.uploaded});
-    std::vector<cl::Event> after{traced};
-    queue.enqueueReadBuffer(s.out, CL_FALSE, 0, n * out_bytes_, out + first * out_bytes_, &after, &s.read_back);
     queue.flush();
+    std::vector<cl::Event> after{traced};
+    transfers.enqueueReadBuffer(s.out, CL_FALSE, 0, n * out_bytes_, out + first * out_bytes_, &after, &s.read_back);
+    transfers.flush();
   }
   for (Slot& s : slot)
     if (s.read_back()) s.read_back.wait();

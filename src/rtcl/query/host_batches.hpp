@@ -14,9 +14,10 @@
 //   Packed batches alternate between two halves of the staging memory, so
 //   that the host packs batch b + 1 while the device traces batch b.
 // - Other devices: two slots of device buffers; batch b uploads into slot
-//   b % 2 while the device may still trace batch b - 1, then traces and
-//   reads back without blocking, so that the host prepares the next batch
-//   while the device works. RTCL_HOST_ARRAYS=copy selects this way on every
+//   b % 2 through a transfer queue of its own while the device's queue may
+//   still trace batch b - 1, then traces and reads back without blocking
+//   (events order each batch's steps), so that copies overlap traces and
+//   the host prepares the next batch while the device works. RTCL_HOST_ARRAYS=copy selects this way on every
 //   device (the tests run both on PoCL).
 #pragma once
 
