@@ -148,18 +148,9 @@ cl::Event Accel::trace_locked(Query query, const cl::Buffer& rays, const cl::Buf
       before = {passes.back()};
       st.first_event = passes.front();
     }
-    // A fixed work-group size (global rounded up; the kernels check ray_count):
-    // PoCL generates code per local size, and left to choose (NULL) it picks
-    // one per global size, so each new ray count would cost a code generation.
-    const std::size_t group = 64;
-    bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_.device()) >= group;
     const TraceKernels& spec = set.spec;
     std::size_t per_item = spec.rays_per_work_item * (query == Query::any ? spec.occluder_run : 1);
-    std::size_t items = (ray_count + per_item - 1) / per_item;
-    std::size_t global = fixed ? (items + group - 1) / group * group : items;
-    device_.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
-                                         fixed ? cl::NDRange(group) : cl::NullRange,
-                                         before.empty() ? nullptr : &before, &done);
+    done = detail::AccelAccess::launch(*this, kernel, (ray_count + per_item - 1) / per_item, before);
     if (!set.ordered) st.first_event = done;
     std::size_t q = query == Query::closest ? 0 : 1;
     if (coherence == Coherence::scattered && st.scattered && device_.profiling() && !st.pending[q] && slot.launches > 0)
@@ -232,6 +223,29 @@ cl::Kernel& AccelAccess::kernel(const Accel& accel, const std::string& file, con
     accel.set_structure_args(kernel, first_structure_arg);
     return kernels.emplace(key, std::move(kernel)).first->second;
   });
+}
+
+void AccelAccess::require_plain_bvh8(const Accel& accel, const char* call) {
+  if (accel.plain_bvh8()) return;
+  throw Error(std::string(call) + ": structure " + accel.name() +
+              " does not support this query (supported: bvh, bvh-ploc, bvh-packet)");
+}
+
+cl::Event AccelAccess::launch(const Accel& accel, const cl::Kernel& kernel, std::size_t items,
+                              const std::vector<cl::Event>& wait) {
+  constexpr std::size_t kGroup = 64;
+  const Device& device = accel.device_;
+  cl::Event done;
+  if (items == 0) {
+    device.queue().enqueueMarkerWithWaitList(&wait, &done);
+    return done;
+  }
+  const bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device.device()) >= kGroup;
+  const std::size_t global = fixed ? (items + kGroup - 1) / kGroup * kGroup : items;
+  device.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
+                                      fixed ? cl::NDRange(kGroup) : cl::NullRange,
+                                      wait.empty() ? nullptr : &wait, &done);
+  return done;
 }
 
 }  // namespace rtcl::detail

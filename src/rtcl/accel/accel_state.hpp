@@ -72,6 +72,17 @@ namespace detail {
 struct AccelAccess {
   static std::mutex& mutex(const Accel& accel) { return accel.state_->mutex; }
   static bool plain_bvh8(const Accel& accel) { return accel.plain_bvh8(); }
+  // Throws Error "CALL: structure NAME does not support this query
+  // (supported: ...)" unless the structure is laid out as the plain 8-wide
+  // BVH, which the kernels of kernels/query/ walk.
+  static void require_plain_bvh8(const Accel& accel, const char* call);
+  // Enqueues `kernel` over `items` work-items after `wait`, in work-groups
+  // of a fixed size where the kernel allows (the global size rounded up; the
+  // kernels check their counts): PoCL generates code per local size, and
+  // left to choose (NULL) it picks one per global size, so each new count
+  // would cost a code generation.
+  static cl::Event launch(const Accel& accel, const cl::Kernel& kernel, std::size_t items,
+                          const std::vector<cl::Event>& wait);
   // Staging memory of host-array calls; call with mutex(accel) held.
   static std::vector<unsigned char>& staging(const Accel& accel) { return accel.state_->staging; }
   // Kernel `kernel_name` of kernels/`file`, built with the structure's

@@ -22,12 +22,6 @@ constexpr std::size_t kPointBytes = 3 * sizeof(float);
 // The kernel's own arguments (points, out, count, max_distance) come first.
 constexpr cl_uint kFirstStructureArg = 4;
 
-void require_bvh8(const Accel& accel, const char* call) {
-  if (!detail::AccelAccess::plain_bvh8(accel))
-    throw Error(std::string(call) + ": structure " + accel.name() +
-                " does not support this query (supported: bvh, bvh-ploc, bvh-packet)");
-}
-
 void check_max_distance(float max_distance, const char* call) {
   if (std::isnan(max_distance) || max_distance < 0.0f)
     throw Error(std::string(call) + ": max_distance " + std::to_string(max_distance) +
@@ -59,15 +53,7 @@ cl::Event enqueue_locked(const Accel& accel, const cl::Buffer& points, const cl:
     kernel.setArg(1, out);
     kernel.setArg(2, static_cast<cl_uint>(count));
     kernel.setArg(3, max_distance);
-    // A fixed work-group size, as the trace kernels (PoCL generates code per
-    // local size); the kernel checks count.
-    const std::size_t group = 64;
-    bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device.device()) >= group;
-    std::size_t global = fixed ? (count + group - 1) / group * group : count;
-    device.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
-                                        fixed ? cl::NDRange(group) : cl::NullRange,
-                                        wait.empty() ? nullptr : &wait, &done);
-    return done;
+    return detail::AccelAccess::launch(accel, kernel, count, wait);
   });
 }
 
@@ -75,7 +61,7 @@ cl::Event enqueue_locked(const Accel& accel, const cl::Buffer& points, const cl:
 // in errors.
 void closest_points_on_host(const Accel& accel, const Points& points, std::span<PointHit> out, float max_distance,
                             const char* call) {
-  require_bvh8(accel, call);
+  detail::AccelAccess::require_plain_bvh8(accel, call);
   if (out.size() != points.size())
     throw Error(std::string(call) + ": out holds " + std::to_string(out.size()) + " records for " +
                 std::to_string(points.size()) + " points");
@@ -115,7 +101,7 @@ std::vector<float> Accel::distance(const Points& points) const {
 cl::Event Accel::closest_points(const cl::Buffer& points, const cl::Buffer& out, std::size_t point_count,
                                 float max_distance, const std::vector<cl::Event>& wait) const {
   const char* call = "closest_points";
-  require_bvh8(*this, call);
+  detail::AccelAccess::require_plain_bvh8(*this, call);
   check_max_distance(max_distance, call);
   return with_cl_errors([&] {
     if (point_count > 0xffffffffu)

@@ -28,34 +28,10 @@ namespace {
 using detail::AccelAccess;
 
 constexpr const char* kFile = "query/count_hits.cl";
-constexpr std::size_t kGroup = 64;
-
-void require_supported(const Accel& accel, const char* call) {
-  if (!AccelAccess::plain_bvh8(accel))
-    throw Error(std::string(call) + ": structure " + accel.name() +
-                " does not support this query (supported: bvh, bvh-ploc, bvh-packet)");
-}
 
 void require_rays(const Rays& rays, const char* call) {
   if (rays.size() > 0 && rays.are_records() && !rays.records().data())
     throw Error(std::string(call) + ": null rays array");
-}
-
-// Launches `kernel` over n work-items (rounded up to whole groups of kGroup
-// where the kernel allows: PoCL generates code per local size).
-cl::Event launch(const Accel& accel, const cl::Kernel& kernel, std::size_t n, const std::vector<cl::Event>& wait) {
-  const Device& device = accel.device();
-  cl::Event done;
-  if (n == 0) {
-    device.queue().enqueueMarkerWithWaitList(&wait, &done);
-    return done;
-  }
-  bool fixed = kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device.device()) >= kGroup;
-  std::size_t global = fixed ? (n + kGroup - 1) / kGroup * kGroup : n;
-  device.queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global),
-                                      fixed ? cl::NDRange(kGroup) : cl::NullRange, wait.empty() ? nullptr : &wait,
-                                      &done);
-  return done;
 }
 
 // The count kernel over rays[0 .. n) into counts; mutex held.
@@ -65,7 +41,7 @@ cl::Event enqueue_count(const Accel& accel, const cl::Buffer& rays, const cl::Bu
   kernel.setArg(0, rays);
   kernel.setArg(1, counts);
   kernel.setArg(2, static_cast<cl_uint>(n));
-  return launch(accel, kernel, n, wait);
+  return AccelAccess::launch(accel, kernel, n, wait);
 }
 
 // count on host arrays, arguments checked; mutex held.
@@ -82,7 +58,7 @@ void count_locked(const Accel& accel, const Rays& rays, std::uint32_t* counts) {
 }  // namespace
 
 void Accel::count(const Rays& rays, std::span<std::uint32_t> counts) const {
-  require_supported(*this, "count");
+  AccelAccess::require_plain_bvh8(*this, "count");
   require_rays(rays, "count");
   if (counts.size() != rays.size())
     throw Error("count: counts holds " + std::to_string(counts.size()) + " values for " +
@@ -100,7 +76,7 @@ std::vector<std::uint32_t> Accel::count(const Rays& rays) const {
 
 cl::Event Accel::count(const cl::Buffer& rays, const cl::Buffer& counts, std::size_t ray_count,
                        const std::vector<cl::Event>& wait) const {
-  require_supported(*this, "count");
+  AccelAccess::require_plain_bvh8(*this, "count");
   return with_cl_errors([&] {
     if (ray_count > 0xffffffffu) throw Error("count: ray_count " + std::to_string(ray_count) + " exceeds 2^32-1");
     if (ray_count > 0 && (!rays() || !counts())) throw Error("count: null ray or count buffer");
@@ -119,7 +95,7 @@ cl::Event Accel::count(const cl::Buffer& rays, const cl::Buffer& counts, std::si
 }
 
 AllHits Accel::all_hits(const Rays& rays, std::uint32_t max_hits_per_ray) const {
-  require_supported(*this, "all_hits");
+  AccelAccess::require_plain_bvh8(*this, "all_hits");
   require_rays(rays, "all_hits");
   if (max_hits_per_ray == 0)
     throw Error("all_hits: max_hits_per_ray is 0; it must be >= 1 (kAllHitsUnlimited: no cap)");
@@ -174,7 +150,7 @@ AllHits Accel::all_hits(const Rays& rays, std::uint32_t max_hits_per_ray) const 
         kernel.setArg(1, offset_buffer);
         kernel.setArg(2, hit_buffer);
         kernel.setArg(3, static_cast<cl_uint>(n));
-        std::vector<cl::Event> done{launch(*this, kernel, n, {})};
+        std::vector<cl::Event> done{AccelAccess::launch(*this, kernel, n, {})};
         device_.queue().enqueueReadBuffer(hit_buffer, CL_TRUE, 0, hits * sizeof(Hit),
                                           result.hits.data() + result.offsets[first], &done);
       }
