@@ -1,7 +1,12 @@
 #!/usr/bin/env bash
-# Installs missing Debian packages, then configures and builds rtcl in build/.
+# Installs missing Debian packages, then configures and builds rtcl in build/:
+# the library, the `rtcl` tool, the tests and the benchmarks.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+# A build/ that scripts/render.sh configured (tests off, packages found then)
+# is configured afresh, so that packages installed since are found.
+fresh=()
+if grep -qs '^RTCL_BUILD_TESTS:BOOL=OFF' build/CMakeCache.txt; then fresh=(--fresh); fi
+cmake "${fresh[@]}" -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DRTCL_BUILD_TESTS=ON -DRTCL_BUILD_BENCH=ON >/dev/null
 cmake --build build -j "$(nproc)"
