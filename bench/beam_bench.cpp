@@ -23,8 +23,7 @@
 // timed region with another seed; rmse_glass (cornell_glass): the same over
 // the pixels the glass block covers wholly (what is seen through it). With
 // $RTCL_BENCH_BEAM_IMAGES set to a directory, each configuration's image and
-// the reference are written there as <scene>-<name>.png (README, "Beam
-// tracing").
+// the reference are written there as <scene>-<name>.png (docs/rendering.md).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

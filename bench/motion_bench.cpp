@@ -1,5 +1,5 @@
-// The motion BVH's two node-bound forms against each other (README,
-// "Motion blur"):
+// The motion BVH's two node-bound forms against each other
+// (docs/rendering.md):
 //   motion/<scene>/<motion>/<bounds>   kernel time of one closest-hit launch
 //     over the scene's primary rays (pixel order), each ray at its own
 //     uniformly random time; bounds: swept (one box per child over the

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Parallel efficiency and tile-size cost of `rtcl render` under mpirun on
-this host, and the numbers behind the 8- and 64-rank model (README, "rtcl
-render under mpirun").
+this host, and the numbers behind the 8- and 64-rank model
+(docs/rendering.md).
 
   flock /tmp/rtcl-bench.lock nice -n -20 /usr/bin/python3 bench/mpi_scaling.py [--build build] [--repeats 3]
 
@@ -128,7 +128,7 @@ def main():
             slowest = statistics.median(max(x["slowest_ms"] for x in r["ranks"]) for r in rs)
             model[t] = {"tiles": rs[0]["tiles"], "t": rt, "o": ct, "q": sv, "t_max": slowest}
             print(f"| {t} | {rs[0]['tiles']} | {m:.3f} | {m / best:.2f} | {rt:.2f} | {ct:.3f} | {sv:.4f} |")
-        # The model (README, "rtcl render under mpirun"): n tiles of mean
+        # The model (docs/rendering.md): n tiles of mean
         # render time t and overhead o per tile, shared by N ranks of one
         # core each, plus the tail of the slowest tile; rank 0 serves one
         # tile in q, so it cannot finish in less than n q.

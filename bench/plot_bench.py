@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Plots `rtcl bench` results (bench.json, schema rtcl-bench/1; README,
-"rtcl bench"):
+"""Plots `rtcl bench` results (bench.json, schema rtcl-bench/1;
+docs/benchmarks.md):
 
   PREFIX-mrays.png  Mrays/s (kernel time, median with min-max bars) per
                     structure per scene, one panel per ray set and device;

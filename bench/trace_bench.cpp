@@ -200,7 +200,7 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
           ->Unit(benchmark::kMillisecond);
 });
 
-// The mixed-volume BVH with its filters forced (README "bvh-mixed"): one
+// The mixed-volume BVH with its filters forced (docs/structures.md): one
 // kind at cost 0 (wherever it cuts a child's box) and the others off, and
 // all at cost 0 (each node takes the kind that cuts most); the plain BVH
 // and bvh-mixed at its measured costs of the same run are
@@ -220,7 +220,7 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
 // batch = 4, ct = 30) per batch, the empty-space bonus, and the exact
 // sweep below 64 references and throughout (Wald & Havran's build) against
 // the binned default; and the BSP's depth and leaf size; on the ray kinds
-// below; README "BSP and kd-tree".
+// below (docs/structures.md).
 [[maybe_unused]] const bool kd_sweep_registered = add_scene_hook([](const SceneSpec& spec) {
   if (spec.name == "dragon") return;
   std::vector<std::string> specs;

@@ -19,8 +19,8 @@ if [ "$sanitize" -eq 0 ]; then
   bash scripts/build.sh
   export POCL_CACHE_DIR="$PWD/build/pocl-cache"
   # Two tests at a time: half the suite's tests are host-bound (process
-  # start, mesh loading, builds), so the two cores stay busy (measured on the
-  # 2-core machine: 231 s against 475 s one at a time, same 258 tests).
+  # start, mesh loading, builds), so the two cores stay busy and the suite
+  # takes about half as long as one test at a time.
   ctest --test-dir build --output-on-failure -j 2 --timeout 600
   exit 0
 fi

@@ -6,8 +6,7 @@
 //    triangle and sphere tests, so the closest t must be identical and any-hit
 //    must hit exactly when brute force does (box culling must be conservative);
 //  - the double-precision reference (judge_all) everywhere else.
-// What these tests establish is summarised in the README ("Numerical
-// guarantees").
+// What these tests establish is summarised in docs/robustness.md.
 #include <gtest/gtest.h>
 
 #include <cstdio>

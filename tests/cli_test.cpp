@@ -53,7 +53,7 @@ TEST(Cli, TraceWithoutOutputIsAUsageError) {
 }
 
 // Every bad command line: one "rtcl: error:" line naming the option or
-// argument, a pointer to --help, exit 2 (README, "Robustness"); nothing is
+// argument, a pointer to --help, exit 2 (docs/cli.md); nothing is
 // written.
 TEST(CliErrors, UsageErrorsAreOneLineAndExit2) {
   Inputs in;

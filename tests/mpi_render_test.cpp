@@ -36,8 +36,8 @@ std::vector<std::string> with(std::vector<std::string> args, const std::vector<s
   return args;
 }
 
-// For the fault tests: enough work (192 tiles of 8 px, about 3 s on one
-// rank) that every rank is set up and takes tiles before the image is done.
+// For the fault tests: enough work (192 tiles of 8 px, seconds on one rank)
+// that every rank is set up and takes tiles before the image is done.
 std::vector<std::string> long_render_args(const std::string& output) {
   return {"render", "-q", "--width", "128", "--height", "96", "--spp", "16", "--tile", "8", "-o", output};
 }

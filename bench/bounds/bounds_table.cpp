@@ -1,4 +1,4 @@
-// The bounding-volume table (README, "Bounding volumes"): for every mesh in
+// The bounding-volume table (docs/structures.md): for every mesh in
 // ../shared/scenes and four random point clouds, each volume's size relative
 // to the AABB, the three sphere radii, each builder's time, and the
 // easy-reject rate: of random rays that hit the AABB but miss the object

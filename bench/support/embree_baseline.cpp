@@ -126,8 +126,8 @@ constexpr unsigned triangles_geometry_id = 0;
 constexpr unsigned spheres_geometry_id = 1;
 
 // Embree's closest hit as rtcl reports it: primitive ids count the
-// triangles first, then the spheres (README, "Primitive ids"), and a
-// sphere's u = v = 0 (README, "Ray and hit files").
+// triangles first, then the spheres, and a sphere's u = v = 0
+// (docs/file-formats.md).
 Hit embree_hit(float t, float u, float v, unsigned geom_id, unsigned prim_id, std::size_t triangle_count) {
   if (geom_id != spheres_geometry_id) return Hit{t, u, v, static_cast<rtcl_i32>(prim_id)};
   return Hit{t, 0.0f, 0.0f, static_cast<rtcl_i32>(triangle_count + prim_id)};

@@ -30,9 +30,9 @@ struct SceneSpec {
   // whose primitives fill a tiny part of its box.
   float stadium = 0.0f;
   // > 0: the grid (bench/ trace/ and sweep/) traces a subset, every k-th
-  // ray, at most this many, as brute force does: where it is up to ~250x
-  // slower than the BVH (the teapot in its stadium) a full set would take
-  // minutes a launch.
+  // ray, at most this many, as brute force does: where it is orders of
+  // magnitude slower than the BVH (the teapot in its stadium) a full set
+  // would take minutes a launch.
   std::size_t grid_ray_limit = 0;
   // true: camera and light come from the loaded geometry's bounds
   // (fit_camera, fit_light); `camera` and `light` are unused.

@@ -57,8 +57,8 @@ GeometryReport validate(const Geometry& geometry, ZeroAreaTest zero_area_test = 
 Error empty_scene_error(const Geometry& geometry);
 
 // True when the triangle with corners a, b, c has an area of exactly zero
-// in double precision. Inline: the builders test every triangle (an out of
-// line call was 3% of a BVH build).
+// in double precision. Inline: the builders test every triangle, where a
+// call per triangle would be a measurable share of a build.
 inline bool zero_area(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
   const glm::dvec3 da(a), db(b), dc(c);
   const glm::dvec3 n = glm::cross(db - da, dc - da);

@@ -17,12 +17,12 @@
  * that bound from the tree (flatten_bvh8) and compiles with
  * -DRTCL_STACK_SIZE >= it.
  *
- * Shape chosen by measurement on PoCL (CPU, AVX2), where each work-item runs
- * as scalar code around the explicit float8 operations: a per-lane branch
- * with a constant lane index (extracted from registers) beat bit-mask
- * iteration, a branch-free compaction and a float8 sorting network; the
- * traversal stays a separate function (its private arrays stay on the
- * native stack instead of becoming per-work-item arrays).
+ * Shape for PoCL (CPU), where each work-item runs as scalar code around the
+ * explicit float8 operations: the children are pushed by a per-lane branch
+ * with a constant lane index (extracted from registers), the fastest form
+ * there (docs/benchmarks.md); the traversal stays a separate function (its
+ * private arrays stay on the native stack instead of becoming per-work-item
+ * arrays).
  *
  * Mixed volumes (the "bvh-mixed" structure): a node with filter_of[node]
  * >= 0 (RTCL_FILTER_REF of shared/layouts.h) also filters the children its
@@ -34,14 +34,12 @@
  * without any of them the kernel has no filter code and no extra
  * arguments. */
 /* The leaves' triangle test inlined into the traversal (shared/triangle.h):
- * the lanes' arithmetic, 5-10% more rays/s than the call on the bunny, sponza
- * and sibenik, and the block's loads around it, 1-2% more (README,
- * "Results"). */
+ * the lanes' arithmetic and the block's loads around it, which PoCL would
+ * otherwise keep as calls that pass their float8 values through memory. */
 #define RTCL_INLINE_TRIANGLE_LANES
 #define RTCL_INLINE_TRIANGLE_BLOCK
-/* The ray setup inlined into the kernel (shared/ray.h): 0.97-1.14x the
- * kernel time on the twelve bench/ sets, above 1.03x on eleven (README,
- * "Kernel levers on the single-ray BVH"). */
+/* The ray setup inlined into the kernel (shared/ray.h), for the same
+ * reason. */
 #define RTCL_INLINE_RAY_SETUP
 #include "shared/bvh8_stack.h"
 #include "shared/trace.h"
@@ -85,8 +83,8 @@
 #endif
 
 /* Leaf `leaf` (~ a child reference: its block index times two, plus one for
- * spheres) against the ray; whether it hit. Always inlined: called, it cost
- * the closest-hit traversal 3-20% (sponza's primary rays most). */
+ * spheres) against the ray; whether it hit. Always inlined: as a call it
+ * slows the closest-hit traversal. */
 inline __attribute__((always_inline)) int bvh_test_leaf(int leaf, const TraceRay* s, HitState* h,
                                                         global const TriangleBlock* triangles,
                                                         global const SphereBlock* spheres) {

@@ -29,8 +29,7 @@
  * own test rejects). Any hit reports some hit.
  *
  * Stack bound: as in accel/bvh.cl (a node pushes at most its children and
- * pops one), so the host's RTCL_STACK_SIZE is valid here too, for both ways.
- * Measured: README "Packet kernel levers". */
+ * pops one), so the host's RTCL_STACK_SIZE is valid here too, for both ways. */
 /* What the frustum traversal pushes (bvh_frustum_walk) */
 #define RTCL_BVH8_ENTRY(k) (loose ? 8 * ref + (k) : node->child[k])
 #include "shared/bvh8_stack.h"

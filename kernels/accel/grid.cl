@@ -35,15 +35,7 @@
  * Every primitive of every cell up to the current one has then been
  * tested, so nothing nearer remains. Since t_best starts just above tmax,
  * the same test ends the walk at tmax. Any hit ends at the first hit in
- * [tmin, tmax].
- *
- * Measured on PoCL and not kept (README, "Uniform grid"): mailboxing
- * (skipping a reference already tested, one int8 compare each) cost more
- * per reference than the tests it saved; the step as masked 4-lane vector
- * operations instead of a branch on the axis was slower, in the cell walk
- * and in the macrocell walk alike; gathering the references of several
- * cells by index into batches of eight (the layout before the reference
- * lanes) was slower than testing each cell's contiguous lanes. */
+ * [tmin, tmax]. */
 #include "shared/trace.h"
 
 /* Coordinate of cell plane n on axis a: the host builds with the same

@@ -39,7 +39,7 @@
  * narrowed first by the bucket table over the first top_digits digits
  * (the prefix selects one bucket of the sorted table, ~2 leaves on
  * average), so that a lookup reads a few codes instead of log2(leaves)
- * (README, "Octrees", measured both ways: option buckets).
+ * (option buckets; without it, the binary search alone).
  *
  * A leaf's primitives are its own blocks (octree_test_leaf: brute force's
  * block tests, the same t bit for bit). */

@@ -35,9 +35,8 @@ inline __attribute__((always_inline)) uint ray_sort_spread3(uint x) {
   return (x & 1u) | (x & 2u) << 2 | (x & 4u) << 4 | (x & 8u) << 6 | (x & 16u) << 8;
 }
 
-/* Inlined: called, the ray crossed the call through the stack, and the
- * count pass took 1.7x as long (PoCL 3.1, the bunny's and sponza's
- * diffuse bounces). */
+/* Inlined: called, the ray would cross the call through the stack, which
+ * slows the count pass markedly on PoCL. */
 inline __attribute__((always_inline)) uint ray_sort_key(global const Ray* r, float4 lo, float4 scale) {
   const uint top = (1u << RTCL_SORT_ORIGIN_BITS) - 1u;
   uint x = min(top, convert_uint_sat((r->ox - lo.x) * scale.x));

@@ -20,11 +20,9 @@
  * The fast level does not widen. */
 #define RTCL_SLAB_WIDEN (8.0f * FLT_EPSILON)
 
-/* One fused multiply-add per side (measured 1.00-1.02x the single-ray
- * kernel time over nine bench/ sets against a multiply and a subtraction,
- * README "Kernel levers on the single-ray BVH"): the widened value is the
- * exact tn - |tn| * RTCL_SLAB_WIDEN rounded once, within half an ulp of it,
- * as the two-step form's is. */
+/* One fused multiply-add per side, no slower than a multiply and a
+ * subtraction: the widened value is the exact tn - |tn| * RTCL_SLAB_WIDEN
+ * rounded once, within half an ulp of it, as the two-step form's is. */
 inline void rtcl_widen_slab(float8* tn, float8* tf) {
 #ifndef RTCL_PRECISION_FAST
   *tn = fma(-fabs(*tn), (float8)(RTCL_SLAB_WIDEN), *tn);
@@ -75,7 +73,7 @@ RTCL_LANES_INLINE void rtcl_slabs8(float8 nx, float8 ny, float8 nz, float8 fx, f
  * bounds hold for every ray's own rtcl_slabs8 distances (widened alike,
  * monotone again): a box this test rejects, every ray of the packet
  * rejects. One multiplication per plane where min(A * lo, A * hi) takes
- * two and a min (measured: README "Packet kernel levers"). Needs finite
+ * two and a min. Needs finite
  * reciprocals (no NaN arises then). */
 RTCL_LANES_INLINE void rtcl_frustum_slabs8(float8 nx, float8 ny, float8 nz, float8 fx, float8 fy, float8 fz,
                                            float onx, float ony, float onz, float ofx, float ofy, float ofz,

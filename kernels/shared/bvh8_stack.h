@@ -4,9 +4,7 @@
  * decreasing entry distance t_entry within [sp at the node, sp), so the
  * nearest child pops first; an any-hit query skips the sorting and leaves
  * stack_t unwritten: its first hit ends the traversal, so its pops test no
- * entry distance (measured: 0.92-1.13x the shadow rays' kernel time,
- * medians of two runs, above 1.03x in 6 of 8, README "Kernel levers on the
- * single-ray BVH"). `node` is the Bvh8Node whose child[k] is pushed for
+ * entry distance. `node` is the Bvh8Node whose child[k] is pushed for
  * lane k. OpenCL C only. */
 #ifndef RTCL_SHARED_BVH8_STACK_H
 #define RTCL_SHARED_BVH8_STACK_H
@@ -72,10 +70,7 @@
  * the widened entry distance lies above the current hit by less than the
  * slab widening, and the child then visited holds nothing nearer (its
  * tests use the same hit). The next node's address then comes from the node's
- * child load in registers, not from a store and a reload (measured
- * with the one-test edge check: 0.99-1.09x the single-ray BVH's kernel
- * time, above 1.02x on eleven of twelve bench/ sets, README "The nearest
- * child in registers and one zero-edge test"). */
+ * child load in registers, not from a store and a reload. */
 #define RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST                                                   \
   int near_entry = 0;                                                                         \
   {                                                                                           \

@@ -56,7 +56,7 @@ inline int rtcl_is_nan(float x) { return (as_uint(x) & 0x7fffffffu) > 0x7f800000
 inline int8 rtcl_not_nan8(float8 x) { return (as_uint8(x) & 0x7fffffffu) <= 0x7f800000u; }
 inline int8 rtcl_is_finite8(float8 x) { return (as_uint8(x) & 0x7f800000u) != 0x7f800000u; }
 
-/* The invalid-ray rule (README, "Invalid rays"): NaN or ±inf in any origin
+/* The invalid-ray rule (docs/robustness.md): NaN or ±inf in any origin
  * or direction component, a zero direction, a NaN tmin or tmax, or
  * tmin > tmax: the ray reports a miss. */
 /* The rule as one expression over scalars or vectors, from the bit tests
@@ -80,7 +80,7 @@ inline int8 rtcl_ray_valid8(float8 ox, float8 oy, float8 oz, float8 dx, float8 d
 /* How trace_ray_setup is compiled: a plain inline function, which PoCL
  * keeps as a call (the Ray passed by value through memory), or always
  * inlined where the kernel defines RTCL_INLINE_RAY_SETUP (the BVH,
- * kernels/accel/bvh.cl: README, "Kernel levers on the single-ray BVH"). */
+ * kernels/accel/bvh.cl, which traces faster so). */
 #ifdef RTCL_INLINE_RAY_SETUP
 #define RTCL_RAY_SETUP_INLINE inline __attribute__((always_inline))
 #else
@@ -180,8 +180,7 @@ inline float hit_state_t(const HitState* h) {
  * more per call on AVX. */
 /* A lane-generic helper shared by the single-ray and packet tests, inlined
  * whatever the compiler's heuristics say: called, it would pass its float8
- * aggregates through memory (measured: the watertight shear left as a call
- * cost the kd-tree's packets 9%). */
+ * aggregates through memory, a visible cost in the packet kernels. */
 #define RTCL_LANES_INLINE inline __attribute__((always_inline))
 
 inline float8 rtcl_fmax8(float8 a, float8 b) { return select(b, a, a > b); }
@@ -233,9 +232,8 @@ inline float rtcl_max8(float8 a) {
 
 /* Index of the first lane of a that equals m (m is one of a's values; 0
  * where none does). A bit per lane, OR-reduced, and the lowest set bit's
- * index: PoCL turned a loop over the stored lanes into a store and a branch
- * per lane (measured: 1.00-1.27x the BVH's kernel time, medians on the
- * twelve bench/ sets, README "Kernel levers on the single-ray BVH"). */
+ * index: PoCL turns a loop over the stored lanes into a store and a branch
+ * per lane, which is slower. */
 inline int rtcl_lane_of(float8 a, float m) {
   int mask = rtcl_lane_bits8(a == (float8)(m));
   return mask ? 31 - (int)clz(mask & -mask) : 0;

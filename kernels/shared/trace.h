@@ -35,9 +35,9 @@ inline void end_trace(global Hit* hits, uint i, const HitState* h) {
 /* With RTCL_TRACE_ORDER (a Coherence::scattered call, kernels/accel/ray_sort.cl)
  * the kernel takes `global const uint* order` after ray_count: the k-th ray
  * traced is rays[order[k]], and its hit goes to hits[order[k]]. The ray
- * RTCL_TRACE_PREFETCH places ahead in the order is prefetched (the rays
- * are read out of memory order; without it sibenik's diffuse bounces traced
- * at 1.08x the unsorted speed instead of 1.19x, one run). */
+ * RTCL_TRACE_PREFETCH places ahead in the order is prefetched: the rays
+ * are read out of memory order, and without the prefetch the sort keeps
+ * less of its gain. */
 #ifdef RTCL_TRACE_ORDER
 #define RTCL_TRACE_ORDER_PARAM global const uint *order,
 #define RTCL_TRACE_HIT_INDEX(k) order[k]

@@ -156,8 +156,7 @@ RTCL_LANES_INLINE int8 rtcl_crossing_hit8(const Watertight8* w, float8 sz, float
 /* How intersect_triangle_lanes is compiled: a plain inline function, which
  * PoCL keeps as a call (its float8 arguments passed through memory), or
  * always inlined where the kernel defines RTCL_INLINE_TRIANGLE_LANES (the
- * octrees, kernels/shared/octree.h: measured 7-8% faster on the bunny's
- * primary rays, README "Octrees"). */
+ * octrees, kernels/shared/octree.h, which trace faster inlined). */
 #ifdef RTCL_INLINE_TRIANGLE_LANES
 #define RTCL_TRIANGLE_LANES_INLINE RTCL_LANES_INLINE
 #else
@@ -215,9 +214,8 @@ RTCL_TRIANGLE_LANES_INLINE int intersect_triangle_lanes(float8 ax, float8 ay, fl
   }
   return found;
 #else
-  /* any hit: no division when no lane is inside its edges (shadow rays of
-   * sponza 1.04x, the others 1.00x; closest hit loses with this branch,
-   * README "Packet kernel levers") */
+  /* any hit: no division when no lane is inside its edges (closest hit
+   * is faster without the branch) */
   if (RTCL_ANY_HIT && !rtcl_any8(rtcl_watertight_inside8(&w))) return 0;
   float8 t, det;
   int8 ok = rtcl_watertight_hit8(&w, (float8)(s->sz), (float8)(s->tmin), (float8)(h->t_best), &t, &det);
@@ -237,7 +235,7 @@ RTCL_TRIANGLE_LANES_INLINE int intersect_triangle_lanes(float8 ax, float8 ay, fl
 
 /* A block of eight triangles (v[vertex][axis][lane] rows: row 3*vertex+axis).
  * Always inlined where the kernel defines RTCL_INLINE_TRIANGLE_BLOCK (the
- * BVH, kernels/accel/bvh.cl; the octrees measured up to 10% slower with
+ * BVH, kernels/accel/bvh.cl; not the octrees, which trace slower with
  * it). */
 #ifdef RTCL_INLINE_TRIANGLE_BLOCK
 RTCL_LANES_INLINE

@@ -1,9 +1,9 @@
 // Transparent huge pages for the builders' large host arrays. On a host
-// whose page faults are dear (a virtual machine: the 4M-triangle build
-// spent about a fifth of its time faulting 4 KiB pages in), an array
-// advised before its first touch is faulted in 2 MiB pages instead, where
-// the kernel allows them (Linux, transparent_hugepage `madvise` or
-// `always`); elsewhere the advice is a no-op. README "Build levers".
+// whose page faults are dear (a virtual machine, where faulting 4 KiB
+// pages in can take a sizeable share of a multi-million-triangle build),
+// an array advised before its first touch is faulted in 2 MiB pages
+// instead, where the kernel allows them (Linux, transparent_hugepage
+// `madvise` or `always`); elsewhere the advice is a no-op.
 #pragma once
 
 #include <cstddef>

@@ -16,9 +16,9 @@ namespace rtcl {
 
 // Threads for a pass over count items: at most `threads` (0 = every
 // hardware thread), and one more only for every min_per_part items (a
-// part's hand-off to a pooled thread and back, 1-5 us to a spinning thread
-// and 25-100 us to a sleeping one (thread_pool.hpp), costs up to as much as
-// a few thousand primitives' work).
+// part's hand-off to a pooled thread and back, microseconds to a spinning
+// thread and tens of microseconds to a sleeping one (thread_pool.hpp),
+// costs up to as much as a few thousand primitives' work).
 inline unsigned part_count(std::size_t count, unsigned threads, std::size_t min_per_part) {
   const unsigned available = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
   return static_cast<unsigned>(std::clamp<std::size_t>(count / std::max<std::size_t>(min_per_part, 1), 1, available));

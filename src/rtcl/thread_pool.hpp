@@ -1,15 +1,12 @@
 // Host threads that outlive one parallel loop: starting a thread and joining
-// it costs ~75 us on the 2-core development VM, about a tenth of a millisecond
-// per loop, and a BVH build runs a dozen loops (the boxes, the root's
-// binning and partition, the subtrees, the flatten's walk and gather).
+// it costs tens of microseconds (more on a virtual machine), paid per loop,
+// and a BVH build runs a dozen loops (the boxes, the root's binning and
+// partition, the subtrees, the flatten's walk and gather).
 //
-// A thread that runs out of work spins for kSpinTime before it sleeps. On
-// the development VM, waking a sleeping thread took 25-100 us per loop (an
-// empty two-job run_jobs, median: 25 us back to back, 56 us 0.2 ms apart;
-// 2 and 9 us with the spin), and after the build's threads had slept 20 ms,
-// one sibenik build on 2 threads took 1.6-1.7x as long as one right after
-// another; with the spin (and the SAH builder's root split before its
-// tasks) the two are within 10% (README "Build threads that stay awake").
+// A thread that runs out of work spins for kSpinTime before it sleeps:
+// waking a sleeping thread costs tens of microseconds per loop against a
+// few for a spinning one, and threads that have slept long start a build
+// markedly slower than threads kept awake.
 #pragma once
 
 #include <chrono>
@@ -18,8 +15,8 @@
 namespace rtcl {
 
 // How long a thread out of work spins before it sleeps: longer than the
-// serial stretches between a build's parallel loops (200 us still let
-// sponza's threads fall asleep between two of them).
+// serial stretches between a build's parallel loops (a few hundred
+// microseconds on meshes of some 100k triangles).
 inline constexpr std::chrono::microseconds kSpinTime{1000};
 
 // Polls ready() until it returns true (then true) or kSpinTime has passed

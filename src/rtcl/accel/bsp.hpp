@@ -19,10 +19,9 @@ namespace rtcl {
 struct BspConfig {
   // Deepest leaf, in splits (<= kKdMaxDepth); 0 = auto:
   // round(log2(N)) + 6 for N stored primitives. Deeper trees cut clusters
-  // finer at the price of more straddling references and nodes. Measured
-  // (README, "BSP and kd-tree"; bench sweep/<scene>/<kind>/bsp/depth=...):
-  // on the bunny, sponza and sibenik (~70k triangles each) depth 22 was
-  // 1.3-2.5x faster than 18 on primary rays, 26 mixed.
+  // finer at the price of more straddling references and nodes; the + 6
+  // is where deeper trees stop paying on the shared meshes (the depth
+  // sweep: docs/benchmarks.md).
   int depth = 0;
   // A node with at most this many primitives becomes a leaf (>= 1). A leaf
   // is tested in batches of 8, so fewer than 8 saves little testing and

@@ -116,8 +116,7 @@ BuildTree build_binary_bvh(const Geometry& geometry, const BvhConfig& config, st
   };
   if (!config.custom_builder && config.builder == BvhBuilder::sah && config.presplit <= 0.0f) {
     // The SAH builder's own array filled here, without box and id arrays
-    // in between, and the references' bounds gathered in the same pass
-    // (README, "The SAH builder's input").
+    // in between, and the references' bounds gathered in the same pass.
     auto refs = std::make_unique_for_overwrite<SahRef[]>(triangles);
     advise_huge_pages(refs.get(), triangles * sizeof(SahRef));
     struct alignas(64) PartBounds {  // a cache line each: the parts write theirs on their threads
@@ -228,8 +227,8 @@ const OptionSpec& merge_leaves_option() {
 const OptionSpec& greedy_levels_option() {
   static const OptionSpec spec{"greedy_levels", OptionType::integer, std::int64_t{BvhConfig{}.greedy_levels}, 0, 1024, false,
           "top wide levels that open their largest child until eight; below, each wide node takes the "
-          "SAH-optimal layout of its subtree: 2 traced 11 of 12 bench/ sets up to 5% faster than greedy throughout, 0 "
-          "(optimal throughout) sponza's primary rays 1-12% slower"};
+          "SAH-optimal layout of its subtree; 0 = optimal throughout, a level beyond the tree's depth = greedy "
+          "throughout"};
   return spec;
 }
 // SAH and PLOC builds share the node cost's and the leaf cap's defaults.
@@ -242,8 +241,8 @@ const OptionSpec& node_cost_option() {
 }
 const OptionSpec& presplit_option() {
   static const OptionSpec spec{"presplit", OptionType::real, double{BvhConfig{}.presplit}, 0, 1024, false,
-          "split the references of triangles whose box's area exceeds presplit x the mean (0 = off): at 16 "
-          "sponza's primary rays 1.08-1.16x faster, diffuse bounces 0.97-1.03x, 3-13% more build time"};
+          "split the references of triangles whose box's area exceeds presplit x the mean (0 = off): helps "
+          "coherent rays in scenes of long thin triangles, at some build time"};
   return spec;
 }
 const OptionSpec& max_leaf_size_option() {
@@ -255,8 +254,7 @@ const OptionSpec& max_leaf_size_option() {
 const std::vector<OptionSpec>& sah_options() {
   static const std::vector<OptionSpec> options = {
       {"bin_count", OptionType::integer, std::int64_t{SahConfig{}.bin_count}, 2, 256, false,
-       "SAH bins per axis: more find better planes where density is uneven (sponza primary rays +18% from 16 to "
-       "32), at ~10% more build time"},
+       "SAH bins per axis: more find better planes where density is uneven, at a build cost linear in the bins"},
       node_cost_option(),
       max_leaf_size_option(),
       {"max_sah_depth", OptionType::integer, std::int64_t{SahConfig{}.max_sah_depth}, 1, 1024, false,
@@ -304,8 +302,8 @@ const StructureSpec& bvh_ploc_structure() {
   static const StructureSpec spec{
       "bvh-ploc", "8-wide BVH, bottom-up agglomerative clustering (PLOC)",
       {{"search_radius", OptionType::integer, std::int64_t{PlocConfig{}.search_radius}, 1, 1024, false,
-        "clusters searched on each side in Morton order: larger finds closer partners (bunny: r=4 / 64 trace 7% "
-        "slower / 3% faster than 16) at a build cost linear in r"},
+        "clusters searched on each side in Morton order: larger finds closer partners (better trees) at a "
+        "build cost linear in r"},
        node_cost_option(),
        max_leaf_size_option(),
        {"max_depth", OptionType::integer, std::int64_t{PlocConfig{}.max_depth}, 1, 1024, false,

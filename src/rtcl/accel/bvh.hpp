@@ -32,9 +32,9 @@ enum class BvhBuilder {
 // work-item, a node's 8 children in float8 lanes, kernels/accel/bvh.cl) and
 // packet (8 consecutive rays per work-item in float8 lanes,
 // kernels/accel/bvh_packet.cl). Packets win only when the 8 rays are alike
-// (PoCL, `rtcl bench` at 1024^2, pixel order, the bench/ scenes: primary
-// rays 1.4-2.7x the single-ray kernel's rays/s, shadow rays to one light
-// 0.9-1.5x, diffuse bounces 0.56-0.68x).
+// (primary rays in pixel order; shadow rays to one light break even);
+// scattered rays such as diffuse bounces trace faster one per work-item.
+// The rates of both kernels per ray kind: docs/benchmarks.md.
 enum class BvhTraversal {
   by_coherence,  // packets for Coherence::coherent calls on CPU devices (packets_for_coherent_calls), else single rays
   packet,        // packets for every call (measuring and testing the packet kernel on any rays)
@@ -48,29 +48,23 @@ struct BvhConfig {
   // Collapse: two leaves of one wide node share a block when their
   // primitives fit in eight lanes and the SAH does not object (the union's
   // area is at most the sum of theirs): one block test instead of two, fewer
-  // bytes. Rarely applies to SAH trees, whose leaves are already full
-  // (counted with rtcl_tree_visits, since removed, docs/benchmarks.md: 2
-  // blocks of the bunny's 9,631 saved, 49 of sponza's 9,890); off changes
-  // nothing else.
+  // bytes. Rarely applies to SAH trees, whose leaves are already full;
+  // off changes nothing else.
   bool merge_leaves = true;
   // Collapse: the wide nodes of the top greedy_levels levels (the root's
   // is level 1) keep opening their child of largest area until they have
   // eight children; below them each wide node takes the SAH-optimal layout
   // of its subtree (bvh_collapse.hpp). 0: optimal throughout; a level
-  // beyond the tree's depth: greedy throughout. Measured (README "The
-  // collapse into wide nodes", 11 rounds, medians): 2 traced eleven of the
-  // twelve bench/ sets up to 5% faster than greedy throughout (two earlier runs:
-  // 1-10%); optimal throughout traced sponza's primary rays 1-12% slower
-  // than greedy over four runs.
+  // beyond the tree's depth: greedy throughout. The default 2 traces
+  // nearly every bench/ ray set faster than either extreme
+  // (docs/benchmarks.md).
   std::uint32_t greedy_levels = 2;
   // Early split clipping (bvh_presplit.hpp): triangles whose box's surface
   // area exceeds presplit times the mean enter the builder as several
-  // references; 0 = off (the default). Measured (README "Build options
-  // against trace speed"): 16 traced the single-ray primary rays of sponza
-  // 1.13-1.16x and of sibenik 1.03-1.04x faster on the greedy collapse, and
-  // 1.08x and 1.07x on the default collapse (one run), their diffuse bounces
-  // 0.97-1.03x, built sponza in 3-13% more time, split no triangle of the
-  // bunny and added 9 references to the dragon's 100,000.
+  // references; 0 = off (the default). It pays on scenes of long thin
+  // triangles across large boxes (architecture such as sponza: coherent
+  // rays), costs some build time, and leaves evenly tessellated meshes
+  // almost untouched; figures: docs/benchmarks.md.
   float presplit = 0.0f;
   // Occlusion (Query::any): consecutive rays per work-item (packets of 8 in
   // the packet kernel), each tested first against the leaf that blocked the

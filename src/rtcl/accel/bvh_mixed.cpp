@@ -56,17 +56,16 @@ const StructureSpec& bvh_mixed_structure() {
                     bvh_sah_options()};
     const VolumeCosts d;
     s.options.push_back({"sphere_cost", OptionType::real, double{d.sphere}, 0, 64, false,
-                         "cost of a node's eight-sphere filter relative to its eight-box test (measured on PoCL: "
-                         "0.7-1.4); 0 puts spheres wherever they are smaller than the box, large values none"});
+                         "cost of a node's eight-sphere filter relative to its eight-box test; 0 puts spheres "
+                         "wherever they are smaller than the box, large values none"});
     s.options.push_back({"kdop_cost", OptionType::real, double{d.kdop}, 0, 64, false,
-                         "cost of a node's eight 14-DOP diagonal-slab filter relative to its eight-box test "
-                         "(measured on PoCL: 1.1-1.4); 0 puts it wherever it cuts the box, large values nowhere"});
+                         "cost of a node's eight 14-DOP diagonal-slab filter relative to its eight-box test; 0 "
+                         "puts it wherever it cuts the box, large values nowhere"});
     s.options.push_back({"obb_cost", OptionType::real, double{d.obb}, 0, 64, false,
-                         "cost of a node's eight-OBB filter relative to its eight-box test (measured on PoCL: "
-                         "1.5-2.0); 0 puts it wherever it cuts the box, large values nowhere"});
+                         "cost of a node's eight-OBB filter relative to its eight-box test; 0 puts it wherever it "
+                         "cuts the box, large values nowhere"});
     s.options.push_back({"block_cost", OptionType::real, double{d.block}, 0, 64, false,
-                         "cost of one leaf block (eight triangle tests) relative to a node's box test (measured "
-                         "on PoCL: 4.8-9.7)"});
+                         "cost of one leaf block (eight triangle tests) relative to a node's box test"});
     return s;
   }();
   return spec;

@@ -34,8 +34,8 @@ constexpr std::uint32_t kSubtreeRef = 0x80000000u;
 // The split search, the binning and the partition are compiled twice, for
 // AVX2 and for the baseline x86-64, and the loader picks by the CPU (GCC's
 // target_clones, an ifunc), as Embree picks its builders by ISA: the
-// three-operand VEX forms and blends of AVX2 took 3-11% off the small
-// scenes' builds (README "The BVH against Embree on the Zen 5 host"). AVX2
+// three-operand VEX forms and blends of AVX2 shorten the builds of small
+// scenes, where these loops dominate (docs/benchmarks.md). AVX2
 // does not include FMA, so no contraction: the same arithmetic, and the
 // same tree, on every x86-64 CPU. Left out with sanitizers and elsewhere.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
@@ -90,10 +90,9 @@ inline std::uint32_t id_of(const SahRef& r) { return std::bit_cast<std::uint32_t
 // Its box, lane 3 zero in both corners (lower[3] is zero by SahRef's
 // contract; upper[3] is masked). Lane 3 of the record's upper corner holds
 // the id's bits, a denormal float for ids below 2^23: arithmetic on it
-// can take a microcode assist (~100 cycles; a multiply by it made the centre
-// alone most of the build's time), and carried into the bins' boxes it
-// reached every area of the split search. Masked, the bins, the validation
-// and the area bounds took 3-4% less of the build (sibenik, 2 threads).
+// can take a microcode assist (on the order of 100 cycles per operation),
+// and carried into the bins' boxes it would reach every area of the split
+// search. Masked, no arithmetic of the build touches it.
 inline Box box_of(const SahRef& r) {
   Box b = std::bit_cast<Box>(r);
   b.hi = std::bit_cast<Float4>(std::bit_cast<Int4>(b.hi) & Int4{-1, -1, -1, 0});
@@ -347,8 +346,8 @@ class SahBuilder {
   // or one pair on a side and the third on the other), its sides' areas sum
   // to at least one of the four bounds below. Float areas only grow with
   // the box and float sums with their terms, so the bound holds for the
-  // costs find_split computes. Skips the split search at 91% of sponza's
-  // nodes of at most 8 references, 61% of the bunny's.
+  // costs find_split computes. It skips the split search at most small
+  // nodes (at most 8 references) of real meshes.
   bool leaf_wins_any_split(const Range& range, float area) const {
     std::uint32_t top[3] = {range.begin, range.begin, range.begin};
     float top_area[3] = {-1.0f, -1.0f, -1.0f};
@@ -630,8 +629,8 @@ class SahBuilder {
   std::size_t ref_count_;
   Range root_;  // all of refs_
   // Each subtree built as a task has its own nodes (threads never write to
-  // one array: the shared counter and cache lines of one array made each of
-  // two threads 1.2-1.4x slower); child indices are local to the subtree,
+  // one array: a shared counter and shared cache lines would serialise
+  // them); child indices are local to the subtree,
   // or kSubtreeRef | the index of another subtree in subtrees_. Guarded by
   // mutex_ while tasks are added.
   std::vector<std::unique_ptr<std::vector<BuildNode>>> subtrees_;

@@ -19,19 +19,16 @@ struct SahConfig {
   // Bins per axis (2..256) at nodes of at least 8 * bin_count primitives;
   // smaller nodes use n / 8 bins, but at least min(8, bin_count): a node
   // costs O(n + bins), and the plane choice matters most near the root. More
-  // bins find better planes where primitive density is uneven. Measured
-  // (2 cores, PoCL, 1024^2 primary rays): 16 -> 32 bins traced sponza's
-  // primary rays 18% faster, bunny and dragon the same, sibenik 4% slower,
-  // for ~10% more build time; 64 bins gained sponza 5% more. n / 8 bins
-  // (at least 8) instead of n / 32 (at least 16) built sponza, the bunny and
-  // sibenik in 7-18% less time on one thread, their trees' SAH cost within
-  // 1% (+0.9%, 0%, -1%).
+  // bins find better planes where primitive density is uneven (sponza), at
+  // a build cost linear in the bins; 32 is where that gain levels off. The
+  // n / 8 rule below the top keeps small nodes cheap at an SAH cost within
+  // a percent of finer binning (figures: docs/benchmarks.md).
   std::uint32_t bin_count = 32;
   // Cost of entering one binary node relative to testing one block of eight
   // primitives. Higher makes shallower trees with fuller leaves, lower splits
   // more eagerly. With leaves charged ceil(n / 8) blocks they fill anyway
-  // (7.3 of 8 lanes on the bunny): 0.25 .. 2 changed neither bytes (< 3%)
-  // nor trace speed measurably there.
+  // (most of their 8 lanes), so values from 0.25 to 2 change bytes and
+  // trace speed little.
   float node_cost = 0.5f;
   // Largest leaf (1..8). The SAH charges a leaf ceil(n / 8) block tests, so
   // leaves tend to fill the eight lanes; a smaller cap only adds nodes.

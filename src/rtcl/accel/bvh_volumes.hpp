@@ -36,11 +36,9 @@
 namespace rtcl {
 
 // Relative test costs, in units of one node's eight-box float8 slab test.
-// Measured on PoCL (bench volume_cost/bunny/*: 65,536 of the bunny's
-// diffuse rays x 256 records, medians of three runs on the loaded 2-core
-// machine; README, "bvh-mixed"): sphere filter 0.7-1.4 (1.36 on a quieter
-// run), 14-DOP slabs 1.06-1.39, OBBs 1.5-2.0, triangle block 4.8-9.7 (8.1
-// on the quieter run). The defaults round those.
+// The defaults are the kernel-time ratios of the tests on PoCL CPU devices,
+// rounded (bench/volume_cost_bench.cpp, volume_cost/*, measures them on a
+// device; docs/benchmarks.md); other devices may call for other values.
 struct VolumeCosts {
   float sphere = 1.3f;  // the eight-sphere filter of one node
   float kdop = 1.3f;    // the eight 14-DOP diagonal-slab filter

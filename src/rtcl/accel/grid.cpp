@@ -107,9 +107,8 @@ bool clipped_x_extent(const glm::dvec3* tri, double y0, double y1, double z0, do
 // For a triangle (`tri` its vertices), each row of cells along x is first
 // narrowed to the x extent of the triangle clipped to the row's widened
 // slab, so that the exact tests run on about as many cells as the triangle
-// meets, not on its whole box (a long sliver across the grid: a fan of
-// 100,000 triangles around one vertex built in 307 s before, see
-// tests/precision_test.cpp).
+// meets, not on its whole box (a long sliver across the grid would test
+// every cell of its box: the fan of tests/precision_test.cpp).
 template <class Overlaps>
 void emit(const Frame& f, const glm::dvec3& lower, const glm::dvec3& upper, rtcl_i32 ref, bool test_always,
           const Overlaps& overlaps, std::vector<CellRef>& out, const glm::dvec3* tri = nullptr) {

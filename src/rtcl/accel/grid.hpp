@@ -25,26 +25,23 @@ struct GridConfig {
   // Density: about lambda * N cells for N stored primitives, split in
   // proportion to the box's sides (Cleary & Wyvill 1988; Wald et al. 2006).
   // The lecture's trade-off: fewer cells make long lists, more make many
-  // empty cells to walk and more memory. Measured (bench sweep/, PoCL, 2
-  // cores, README "Uniform grid"): time per ray is U-shaped in the cell
-  // count, flat within 18% from lambda 2 to 16 on bunny, sponza and sibenik
-  // (primary and diffuse rays); 8 was the best lambda on three of those six
-  // sets and within 8% on the others, at 160-260 bytes per triangle (40
-  // per reference lane).
+  // empty cells to walk and more memory. Time per ray is U-shaped in the
+  // cell count and flat over a wide range around the default 8 (the sweep:
+  // docs/benchmarks.md); a reference lane costs 40 bytes.
   double lambda = 8.0;
   // Reference budget of an automatic resolution: when a sample of the
   // triangles meets more cells than this on average, lambda is divided by 4
   // until it does not. Long slivers across the grid would otherwise be listed
-  // in hundreds of cells each: a fan of 100,000 triangles around one vertex
-  // took 2.2 GiB and 22 s at lambda 8 (550 references per triangle). Real
-  // meshes stay far below it (3.2 per triangle on the bunny, 6.3 on sponza).
+  // in hundreds of cells each (a fan of thin triangles around one vertex:
+  // hundreds of references per triangle, gigabytes of lists). Real meshes
+  // stay far below it, at a few references per triangle.
   double max_references_per_triangle = 64.0;
   // Explicit resolution; overrides lambda (and the budget) when not {0, 0, 0}.
   GridResolution resolution{0, 0, 0};
   // Side of a macrocell in cells, a power of two in [1, 256]: the walk
   // crosses an empty macrocell in one step (empty-space skipping); 1 makes
-  // every empty cell its own macrocell. Measured (README "Uniform grid"):
-  // 4 and 8 alike on the bunny's primary rays, 2 and 1 slower.
+  // every empty cell its own macrocell. 4 and 8 trace alike on the
+  // shared meshes, 2 and 1 slower (docs/benchmarks.md).
   unsigned macro = 4;
   // Host threads for the overlap pass (0 = 2); the pass splits the
   // triangles into this many contiguous ranges.

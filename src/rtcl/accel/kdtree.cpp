@@ -222,11 +222,10 @@ std::uint8_t side_of(float lower, float upper, float p) {
 // at most kCostlySplits times on a path (after pbrt's "bad refines",
 // Pharr et al., pbrt-v3 section 4.4). Large: more than one run of eight
 // lanes, and more than four runs or an eighth of the scene's primitives.
-// The SAH alone left the Cornell box's 36 triangles in one leaf, its walls
-// spanning every plane, and every ray testing all of them: 0.58-0.68x the
-// BVH's primary rays, 0.88-0.91x with up to three such splits (0.81x with
-// two). Forcing splits of every node above one run built sponza 1.7x
-// longer (README "BSP and kd-tree").
+// The SAH alone can leave a small scene whose walls span every plane (the
+// Cornell box's 36 triangles) in one leaf, every ray testing all of it;
+// three forced splits per path fix that, while forcing splits of every
+// node above one run lengthens the build of large scenes.
 constexpr std::size_t kRun = 8;
 constexpr std::size_t kLargeLeaf = 4 * kRun;
 constexpr int kCostlySplits = 3;
@@ -513,11 +512,10 @@ class BinnedBuilder {
   }
 
   // Planes at the bin boundaries strictly inside the node (a bin per two
-  // references, from 8 to kBins; a bin per reference built sponza's tree
-  // 7-12% slower and traced the same, README "BSP and kd-tree"): N_below
-  // counts the references whose lower bound lies in a bin below the plane,
-  // N_above those whose upper bound lies in a bin above it (both upper
-  // bounds of what the split lists). Axis -1 when no plane beats a leaf.
+  // references, from 8 to kBins): N_below counts the references whose
+  // lower bound lies in a bin below the plane, N_above those whose upper
+  // bound lies in a bin above it (both upper bounds of what the split
+  // lists). Axis -1 when no plane beats a leaf.
   Split find_split(const glm::dvec3& lower, const glm::dvec3& upper, const std::vector<Ref>& refs) const {
     const std::size_t n = refs.size();
     Split best;

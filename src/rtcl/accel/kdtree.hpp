@@ -26,9 +26,9 @@ struct KdTreeConfig {
   // times (1 - empty_bonus) when one side is empty; a leaf costs
   // intersection_cost * N, and a node whose best split costs more is a leaf.
   // Only the ratio of the two costs matters (Mitsuba uses 15 and 20). The
-  // defaults (batch 4, 30) were the fastest to build among the settings
-  // that traced best on the bunny, sponza and sibenik with the binned
-  // build (README, "BSP and kd-tree": bench sweep/<scene>/<kind>/kdtree/...).
+  // defaults (batch 4, 30) are the fastest to build among the settings
+  // that trace best on the shared meshes with the binned build (the sweep:
+  // docs/benchmarks.md).
   double traversal_cost = 30.0;
   double intersection_cost = 20.0;
   // The empty-space bonus (Wald & Havran's 0.8 factor = 0.2; range: the
@@ -40,15 +40,15 @@ struct KdTreeConfig {
   // the classic SAH (cost per primitive); the kernel tests a leaf's
   // contiguous reference lanes in runs of 8 float8 lanes, where 1 and 8
   // triangles cost the same, so 8 models the tests alone: larger leaves, a
-  // shallower tree, fewer references, a faster build. 4 with ct = 30 traced
+  // shallower tree, fewer references, a faster build. 4 with ct = 30 traces
   // faster than 8 with ct = 15 at the same build time.
   unsigned batch = 4;
   // Subtrees of at most this many references are built by the exact
   // sweep over sorted events (Wald & Havran 2006, O(N log N)); larger
   // nodes are split by the same SAH at up to 64 bin boundaries per axis
   // (min-max binning: linear, no sorting). 0: binned throughout (the
-  // default: the faster build, and its trees traced as fast or faster on
-  // the shared meshes, README "BSP and kd-tree"); 2^30: exact throughout.
+  // default: the faster build, and its trees trace as fast or faster on
+  // the shared meshes); 2^30: exact throughout.
   std::size_t exact_below = 0;
   // Host threads (0 = hardware concurrency): the subtrees the binned levels
   // queue, the exact build's large subtrees, and the fused nodes beside the

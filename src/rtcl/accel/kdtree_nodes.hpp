@@ -55,8 +55,8 @@ struct KdTree {
 // References per stored primitive a build may list in all (a subtree's
 // share of them is its reference budget, split between the children in
 // proportion to their counts; a node that cannot split within its share
-// is a leaf). Well-behaved scenes stay far below it (bunny: 2.7 bsp, 3.6
-// kdtree); it bounds the growth where every split keeps most primitives on
+// is a leaf). Well-behaved scenes stay far below it (a few references per
+// primitive); it bounds the growth where every split keeps most primitives on
 // both sides, which is exponential in the depth: a fan of thin triangles
 // around one vertex, whose neighbourhood every node around the vertex
 // lists in full.

@@ -22,17 +22,17 @@ namespace rtcl {
 
 struct OctreeConfig {
   // Maximum depth N (lattice 2^N per axis), 0 .. RTCL_OCTREE_MAX_DEPTH
-  // (16 hexadecimal digits fill the 64-bit code). Measured defaults: README
-  // "Octrees".
+  // (16 hexadecimal digits fill the 64-bit code). The defaults' sweep:
+  // docs/benchmarks.md.
   int max_depth = 10;
-  // Primitives a node may hold and still be a leaf (k >= 1). 32: 0.27x the
-  // BVH on the bunny's primary rays against 0.21x at 8 (README "Octrees").
+  // Primitives a node may hold and still be a leaf (k >= 1). 32 traces
+  // faster than smaller leaves (docs/benchmarks.md).
   std::size_t leaf_size = 32;
   // References per stored primitive the tree may hold (OctreeBuildConfig).
   double ref_budget = 16.0;
   // Index the table by the first digits of a code (bucket_begin, about one
   // bucket per two leaves) before the binary search; false: binary search
-  // over the whole table (measured 1.39x slower on the bunny).
+  // over the whole table, which is slower.
   bool buckets = true;
   // The largest buffer the device can allocate (0: no limit).
   std::size_t max_alloc_bytes = 0;

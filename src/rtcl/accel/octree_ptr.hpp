@@ -25,8 +25,8 @@ constexpr int kOctreePtrMaxDepth = 20;
 
 struct OctreePtrConfig {
   int max_depth = 10;           // levels below the root, 0 .. kOctreePtrMaxDepth
-  // k >= 1; 32 measured best of 4 .. 64 on the bunny's primary rays
-  // (README "Octrees").
+  // k >= 1; 32 is the fastest of 4 .. 64 on primary rays
+  // (docs/benchmarks.md).
   std::size_t leaf_size = 32;
   // References per stored primitive the tree may hold (OctreeBuildConfig).
   double ref_budget = 16.0;
@@ -54,8 +54,8 @@ struct OctreePtr {
 // The device layout of a built tree over the root box [lower, upper]: inner
 // nodes in build order, leaves with primitives numbered in that order, each
 // with its primitives copied into blocks of its own (contiguous float8
-// rows, as BVH leaves: measured faster than gathering shared references,
-// README "Octrees"), empty leaves RTCL_CHILD_EMPTY.
+// rows, as BVH leaves, which trace faster than gathered shared references;
+// docs/structures.md), empty leaves RTCL_CHILD_EMPTY.
 OctreePtr flatten_octree_ptr(const Geometry& geometry, OctreeBuild&& tree, const std::array<float, 3>& lower,
                              const std::array<float, 3>& upper);
 

@@ -16,8 +16,8 @@ namespace rtcl {
 class RaySort {
  public:
   // Origins binned on 2^origin_bits cells per axis over `bounds` (an empty
-  // box: the octant alone); 0 .. 4, else Error. 3 by measurement (README
-  // "Scattered rays sorted on the device").
+  // box: the octant alone); 0 .. 4, else Error. The default 3 sorts the
+  // bench/ scenes' bounces fastest (docs/benchmarks.md).
   RaySort(const Device& device, const Aabb& bounds, int origin_bits = 3);
 
   // Enqueues the sort of rays[0 .. ray_count), ray_count >= 1 (else Error;

@@ -1,8 +1,8 @@
 // Whether a Coherence::scattered trace call sorts its rays on the device
 // first (RaySort) or traces them in the caller's order: the sort pays where
-// a ray visits many nodes and costs where rays are cheap (README "Scattered
-// rays sorted on the device"), which only the calls themselves show. So,
-// by default, an Accel measures: per query kind, the device time per ray
+// a ray visits many nodes and costs where rays are cheap
+// (docs/structures.md), which only the calls themselves show. So, by
+// default, an Accel measures: per query kind, the device time per ray
 // of its finished scattered calls, sorted and not (not the first launch of
 // either way's kernel, whose time includes PoCL's code generation), and
 // sorts when sorting measured faster.

@@ -25,7 +25,7 @@ const OptionSpec& occluder_run_option();
 // (`bvh`, `bvh-ploc` and `kdtree`; `bvh-packet` and `kdtree-packet` take it
 // for every call): on CPU devices, where a packet's eight rays fill a
 // work-item's float8 lanes; not on others, where every ray is a work-item
-// of its own (docs/benchmarks.md, "On a GPU").
+// of its own (docs/benchmarks.md).
 bool packets_for_coherent_calls(const DeviceInfo& device);
 
 // The -D options every trace program needs for this geometry.

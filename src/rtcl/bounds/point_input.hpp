@@ -1,7 +1,7 @@
 // The input every bounding-volume builder shares: a point set, its checks,
 // and outward rounding of double results to float.
 //
-// Degenerate input (README, "Bounding volumes"): an empty set and a NaN or
+// Degenerate input (docs/robustness.md): an empty set and a NaN or
 // infinite coordinate are errors (rtcl::Error naming the source and, for a
 // bad coordinate, the point's index); one point, equal points, collinear and
 // coplanar points are valid and give volumes with zero extent along the

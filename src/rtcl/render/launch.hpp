@@ -2,7 +2,8 @@
 // size is rounded up to a multiple of it (every kernel checks its index
 // against its count). A fixed local size matters on PoCL: it generates code
 // per local size, and with the default (NULL) it picks one from each global
-// size, so every new queue length would cost a code generation (~0.1-1 s).
+// size, so every new queue length would cost a code generation (a
+// fraction of a second or more each).
 #pragma once
 
 #include <cstddef>

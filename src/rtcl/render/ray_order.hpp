@@ -9,9 +9,9 @@
 //    high), then that of the unit direction quantised on [-1, 1] (30 bits,
 //    low); 10 bits per axis (after Garanzha and Loop 2010, "Fast ray sorting
 //    and breadth-first packet traversal for GPU ray tracing", which sort by a
-//    hash of origin and direction). Origin-major because it measured faster
-//    than interleaving all six axes (bench trace/*/diffuse-morton, bunny:
-//    packets 7.8 vs 5.2 Mrays/s, single ray 10.6 vs 9.0).
+//    hash of origin and direction). Origin-major because it traces faster
+//    than interleaving all six axes, with packets and single rays alike
+//    (bench trace/*/diffuse-morton; docs/benchmarks.md).
 // An order is a permutation: order[k] is the index (in the original
 // sequence) of the ray placed at position k. gather() applies it to rays
 // (or anything parallel to them), scatter() puts answers traced in that
@@ -37,9 +37,8 @@ std::vector<std::uint32_t> tile_order(std::uint32_t width, std::uint32_t height)
 // row by row; clipped at the image's edges. Eight consecutive rays are
 // then a 4x2 block, the most compact 8-pixel shape: the order of `rtcl
 // bench`'s primary rays, so that the packets it compares with Embree's
-// rtcIntersect8 are the ones Embree traces fastest (measured against rows
-// of 8x1 pixels, 1024^2, bunny, sponza, sibenik: rtcIntersect8 9-20%
-// faster, rtcl's packets within the run-to-run noise).
+// rtcIntersect8 are the ones Embree traces fastest (faster than rows of
+// 8x1 pixels; rtcl's packets trace both shapes alike).
 std::vector<std::uint32_t> packet_tile_order(std::uint32_t width, std::uint32_t height);
 
 // The 60-bit Morton key of one ray (see above). Origins outside `bounds`

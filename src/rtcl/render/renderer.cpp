@@ -471,9 +471,7 @@ void Renderer::compact() {
 
 // trace_shadows: any hit of every shadow ray. Coherent: the queue keeps the
 // order of the rays that spawned them, so consecutive shadow rays leave
-// neighbouring points towards the same few point lights. (Promising only the
-// camera generation's shadow rays measured no different on sponza with
-// reflections: bench render/sponza-kr25.)
+// neighbouring points towards the same few point lights.
 void Renderer::trace_shadows() {
   State& s = *s_;
   if (s.shadows.size() == 0) return;

@@ -1,5 +1,5 @@
 // The scene file: JSON a person can write by hand (comments allowed), read
-// strictly. Format and an example: README.md, "Scene files". Paths inside are
+// strictly. Format and an example: docs/file-formats.md. Paths inside are
 // relative to the scene file's directory.
 //
 // MTL materials of meshes become scene materials: Ka -> ambient (Kd when Ka
