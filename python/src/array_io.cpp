@@ -6,6 +6,7 @@
 #include <mutex>
 #include <string>
 
+#include "rtcl/huge_pages.hpp"
 #include "rtcl/parallel.hpp"
 
 namespace rtcl::python {
@@ -60,14 +61,15 @@ inline float value(const char* record, py::ssize_t stride, int k) {
 }
 
 template <class T>
-void pack_rays_as(const FloatRecords& r, float tmin, float tmax, std::span<Ray> out) {
+void pack_rays_as(const FloatRecords& r, std::size_t first, float tmin, float tmax, std::span<Ray> out,
+                  bool parallel) {
   const py::ssize_t s = r.value_stride;
   for_parts(out.size(), [&](std::size_t begin, std::size_t end) {
-    walk(r, begin, end, [&](std::size_t i, const char* p) {
-      out[i] = Ray{value<T>(p, s, 0), value<T>(p, s, 1), value<T>(p, s, 2), value<T>(p, s, 3),
+    walk(r, first + begin, first + end, [&](std::size_t i, const char* p) {
+      out[i - first] = Ray{value<T>(p, s, 0), value<T>(p, s, 1), value<T>(p, s, 2), value<T>(p, s, 3),
                            value<T>(p, s, 4), value<T>(p, s, 5), tmin, tmax};
     });
-  });
+  }, parallel);
 }
 
 std::string index_text(const std::vector<py::ssize_t>& shape, std::size_t flat) {
@@ -83,31 +85,52 @@ std::string index_text(const std::vector<py::ssize_t>& shape, std::size_t flat) 
 }
 
 template <class T>
-void pack_points_as(const FloatRecords& r, std::span<float> out, const char* call, const char* param) {
+void pack_points_as(const FloatRecords& r, std::size_t first, std::span<float> out, bool parallel) {
   const py::ssize_t s = r.value_stride;
-  const std::size_t none = std::numeric_limits<std::size_t>::max();
-  std::mutex lock;
-  std::size_t bad = none;
-  for_parts(r.count, [&](std::size_t begin, std::size_t end) {
-    std::size_t mine = none;
-    walk(r, begin, end, [&](std::size_t i, const char* p) {
-      const float x = value<T>(p, s, 0), y = value<T>(p, s, 1), z = value<T>(p, s, 2);
-      out[3 * i] = x;
-      out[3 * i + 1] = y;
-      out[3 * i + 2] = z;
-      if (mine == none && !(std::isfinite(x) && std::isfinite(y) && std::isfinite(z))) mine = i;
+  for_parts(out.size() / 3, [&](std::size_t begin, std::size_t end) {
+    walk(r, first + begin, first + end, [&](std::size_t i, const char* p) {
+      float* o = &out[3 * (i - first)];
+      o[0] = value<T>(p, s, 0);
+      o[1] = value<T>(p, s, 1);
+      o[2] = value<T>(p, s, 2);
     });
-    if (mine != none) {
-      std::lock_guard guard(lock);
-      bad = std::min(bad, mine);
-    }
+  }, parallel);
+}
+
+// The first point with a coordinate that is not finite as a float, or
+// r.count.
+template <class T>
+std::size_t first_bad_point(const FloatRecords& r) {
+  const py::ssize_t s = r.value_stride;
+  std::mutex lock;
+  std::size_t bad = r.count;
+  for_parts(r.count, [&](std::size_t begin, std::size_t end) {
+    std::size_t mine = r.count;
+    walk(r, begin, end, [&](std::size_t i, const char* p) {
+      if (mine == r.count &&
+          !(std::isfinite(value<T>(p, s, 0)) && std::isfinite(value<T>(p, s, 1)) && std::isfinite(value<T>(p, s, 2))))
+        mine = i;
+    });
+    std::lock_guard guard(lock);
+    bad = std::min(bad, mine);
   });
-  if (bad != none)
-    throw py::value_error(std::string(call) + ": " + param + index_text(r.shape, bad) +
-                          " has a NaN or infinite coordinate");
+  return bad;
 }
 
 }  // namespace
+
+void* output_memory(std::size_t bytes) {
+  constexpr std::size_t huge = std::size_t{2} << 20;
+  void* p = nullptr;
+  if (bytes >= kHugePageAdviceBytes) {
+    p = std::aligned_alloc(huge, (bytes + huge - 1) / huge * huge);
+    if (p) advise_huge_pages(p, bytes);
+  } else {
+    p = std::malloc(std::max<std::size_t>(bytes, 1));
+  }
+  if (!p) throw std::bad_alloc();
+  return p;
+}
 
 std::string shape_text(const std::vector<py::ssize_t>& shape) {
   std::string text = "(";
@@ -115,7 +138,11 @@ std::string shape_text(const std::vector<py::ssize_t>& shape) {
   return text + (shape.size() == 1 ? ",)" : ")");
 }
 
-void for_parts(std::size_t count, const std::function<void(std::size_t, std::size_t)>& fn) {
+void for_parts(std::size_t count, const std::function<void(std::size_t, std::size_t)>& fn, bool parallel) {
+  if (!parallel) {
+    fn(0, count);
+    return;
+  }
   for_each_part(count, part_count(count, 0, std::size_t(1) << 16),
                 [&](unsigned, std::size_t begin, std::size_t end) { fn(begin, end); });
 }
@@ -147,18 +174,26 @@ FloatRecords float_records(py::handle object, int width, const char* call, const
   return r;
 }
 
-void pack_rays(const FloatRecords& rays, float tmin, float tmax, std::span<Ray> out) {
+void pack_rays(const FloatRecords& rays, std::size_t first, float tmin, float tmax, std::span<Ray> out,
+               bool parallel) {
   if (rays.float64)
-    pack_rays_as<double>(rays, tmin, tmax, out);
+    pack_rays_as<double>(rays, first, tmin, tmax, out, parallel);
   else
-    pack_rays_as<float>(rays, tmin, tmax, out);
+    pack_rays_as<float>(rays, first, tmin, tmax, out, parallel);
 }
 
-void pack_points(const FloatRecords& points, std::span<float> out, const char* call, const char* param) {
+void pack_points(const FloatRecords& points, std::size_t first, std::span<float> out, bool parallel) {
   if (points.float64)
-    pack_points_as<double>(points, out, call, param);
+    pack_points_as<double>(points, first, out, parallel);
   else
-    pack_points_as<float>(points, out, call, param);
+    pack_points_as<float>(points, first, out, parallel);
+}
+
+void check_points(const FloatRecords& points, const char* call, const char* param) {
+  const std::size_t bad = points.float64 ? first_bad_point<double>(points) : first_bad_point<float>(points);
+  if (bad != points.count)
+    throw py::value_error(std::string(call) + ": " + param + index_text(points.shape, bad) +
+                          " has a NaN or infinite coordinate");
 }
 
 std::vector<glm::vec3> read_vertices(py::handle object, const char* call, const char* param) {

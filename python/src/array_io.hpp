@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
 #include <span>
 #include <string>
@@ -43,16 +44,22 @@ struct FloatRecords {
 // With `matrix`, the array must be (N, width) exactly.
 FloatRecords float_records(py::handle object, int width, const char* call, const char* param, bool matrix = false);
 
-// The rays (out.size() == rays.count) of a (..., 6) array (ox oy oz dx dy dz),
-// with tmin and tmax, as Ray records; NaN and infinite values are kept (the
-// library answers such rays as misses). No GIL needed.
-void pack_rays(const FloatRecords& rays, float tmin, float tmax, std::span<Ray> out);
+// Rays [first, first + out.size()) of a (..., 6) array (ox oy oz dx dy dz),
+// in the order of its flattened leading shape, with tmin and tmax, as Ray
+// records; NaN and infinite values are kept (the library answers such rays
+// as misses). No GIL needed.
+// With parallel = false on the calling thread only.
+void pack_rays(const FloatRecords& rays, std::size_t first, float tmin, float tmax, std::span<Ray> out,
+               bool parallel = true);
 
-// The points of a (..., 3) array as 3 floats each. Throws py::value_error
-// "CALL: PARAM[i, j] has a NaN or infinite coordinate" for the first such
-// point (float64 values beyond float's range count as infinite). No GIL
-// needed.
-void pack_points(const FloatRecords& points, std::span<float> out, const char* call, const char* param);
+// Throws py::value_error "CALL: PARAM[i, j] has a NaN or infinite
+// coordinate" for the first such point of a (..., 3) array (float64 values
+// beyond float's range count as infinite): before any work. No GIL needed.
+void check_points(const FloatRecords& points, const char* call, const char* param);
+
+// Points [first, first + out.size() / 3) of a (..., 3) array as 3 floats
+// each (checked before by check_points). No GIL needed.
+void pack_points(const FloatRecords& points, std::size_t first, std::span<float> out, bool parallel = true);
 
 // Vertices (N, 3) float32 / float64, finite or not (the mesh's own check
 // names the vertex), and triangles (M, 3) of any integer dtype with indices
@@ -60,20 +67,31 @@ void pack_points(const FloatRecords& points, std::span<float> out, const char* c
 std::vector<glm::vec3> read_vertices(py::handle object, const char* call, const char* param);
 std::vector<glm::uvec3> read_triangles(py::handle object, const char* call, const char* param);
 
-// A fresh C-contiguous output array of shape leading + trailing.
+// Memory for an output array of `bytes`, released by free(): from 4 MiB up
+// aligned to 2 MiB and advised for huge pages, so that its first touch
+// (while the answers are written) costs one page fault per 2 MiB, not per
+// 4 KiB (rtcl/huge_pages.hpp). Throws std::bad_alloc.
+void* output_memory(std::size_t bytes);
+
+// A fresh C-contiguous output array of shape leading + trailing, its memory
+// from output_memory (owned by the array).
 template <class T>
 py::array_t<T> output_array(const std::vector<py::ssize_t>& leading, std::initializer_list<py::ssize_t> trailing = {}) {
   std::vector<py::ssize_t> shape = leading;
   shape.insert(shape.end(), trailing.begin(), trailing.end());
-  return py::array_t<T>(shape);
+  std::size_t count = 1;
+  for (py::ssize_t n : shape) count *= static_cast<std::size_t>(n);
+  void* memory = output_memory(count * sizeof(T));
+  py::capsule owner(memory, [](void* p) { std::free(p); });
+  return py::array_t<T>(shape, static_cast<T*>(memory), owner);
 }
 
 // "(4, 3)"; "(6,)" for one axis.
 std::string shape_text(const std::vector<py::ssize_t>& shape);
 
 // Calls fn(begin, end) over contiguous parts of [0, count) on the library's
-// host threads (rtcl/parallel.hpp), one part per 64k items at most 1 per
-// hardware thread.
-void for_parts(std::size_t count, const std::function<void(std::size_t, std::size_t)>& fn);
+// host threads (rtcl/parallel.hpp), one part per 64k items, at most one per
+// hardware thread; with parallel = false one part on the calling thread.
+void for_parts(std::size_t count, const std::function<void(std::size_t, std::size_t)>& fn, bool parallel = true);
 
 }  // namespace rtcl::python

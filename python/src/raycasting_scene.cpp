@@ -13,6 +13,7 @@
 #include "array_io.hpp"
 #include "devices.hpp"
 #include "mesh_scene.hpp"
+#include "scratch.hpp"
 #include "rtcl/accel_options.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/precision.hpp"
@@ -44,23 +45,53 @@ unsigned check_nsamples(long long nsamples, const char* call) {
 
 Coherence coherence_of(bool coherent) { return coherent ? Coherence::coherent : Coherence::incoherent; }
 
-// The rays as records, or nothing when there is nothing to trace (no ray,
-// or no primitive to hit): the caller then writes misses.
-struct Traced {
-  std::shared_ptr<const BuiltScene> built;
-  std::vector<Ray> rays;
-  bool empty() const { return !built || !built->accel; }
+// The structure over the scene's meshes as they are now, or null when there
+// is nothing to query (no ray or point, or nothing to hit): the caller then
+// writes misses.
+const Accel* structure(const MeshScene& scene, std::size_t count, std::shared_ptr<const BuiltScene>& built) {
+  if (count == 0) return nullptr;
+  built = scene.snapshot();
+  return built->accel.get();
+}
+
+// Two sets of scratch arrays for pipeline()'s slots.
+struct Slots {
+  ScratchLease a, b;
+  Scratch& operator[](int slot) { return slot == 0 ? *a : *b; }
 };
 
-Traced prepare_rays(const MeshScene& scene, const FloatRecords& rays, float tmin, float tmax) {
-  Traced t;
-  if (rays.count == 0) return t;
-  t.built = scene.snapshot();
-  if (t.empty()) return t;
-  t.rays.resize(rays.count);
-  pack_rays(rays, tmin, tmax, t.rays);
-  return t;
+Rays records(Scratch& scratch, std::size_t n) { return Rays(std::span<const Ray>(scratch.rays.data(), n)); }
+
+Points points_of(Scratch& scratch, std::size_t n) { return Points(std::span<const float>(scratch.xyz.data(), 3 * n)); }
+
+// The ray queries' pipeline: each chunk's rays packed into its slot, then
+// run(scratch, first, n), then unpack(scratch, first, n, parallel).
+template <class Run, class Unpack>
+void ray_pipeline(const FloatRecords& rays, float tmin, float tmax, Run&& run, Unpack&& unpack) {
+  Slots slots;
+  pipeline(
+      rays.count,
+      [&](int slot, std::size_t first, std::size_t n, bool parallel) {
+        pack_rays(rays, first, tmin, tmax, Scratch::first(slots[slot].rays, n), parallel);
+      },
+      [&](int slot, std::size_t first, std::size_t n) { run(slots[slot], first, n); },
+      [&](int slot, std::size_t first, std::size_t n, bool parallel) { unpack(slots[slot], first, n, parallel); });
 }
+
+// The same for the point queries.
+template <class Run, class Unpack>
+void point_pipeline(const FloatRecords& points, Run&& run, Unpack&& unpack) {
+  Slots slots;
+  pipeline(
+      points.count,
+      [&](int slot, std::size_t first, std::size_t n, bool parallel) {
+        pack_points(points, first, Scratch::first(slots[slot].xyz, 3 * n), parallel);
+      },
+      [&](int slot, std::size_t first, std::size_t n) { run(slots[slot], first, n); },
+      [&](int slot, std::size_t first, std::size_t n, bool parallel) { unpack(slots[slot], first, n, parallel); });
+}
+
+constexpr auto kNothing = [](Scratch&, std::size_t, std::size_t, bool) {};
 
 py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthreads, double tnear, double tfar,
                    bool coherent) {
@@ -80,34 +111,42 @@ py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthread
   float* n_out = normals.mutable_data();
   {
     py::gil_scoped_release release;
-    Traced traced = prepare_rays(scene, rays, tmin, tmax);
-    std::vector<Hit> hits;
-    if (!traced.empty()) {
-      hits.resize(rays.count);
-      traced.built->accel->trace(Query::closest, Rays(traced.rays), hits, coherence_of(coherent));
-      std::vector<Ray>().swap(traced.rays);
-    }
-    const BuiltScene* built = traced.built.get();
-    for_parts(rays.count, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        if (hits.empty() || hits[i].prim < 0) {
-          t_out[i] = kInf;
-          g_out[i] = p_out[i] = kInvalidId;
-          uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
-          n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
-          continue;
-        }
-        const Hit& h = hits[i];
-        t_out[i] = h.t;
-        built->locate(h.prim, g_out[i], p_out[i]);
-        uv_out[2 * i] = h.u;
-        uv_out[2 * i + 1] = h.v;
-        const glm::vec3& n = built->normals[static_cast<std::size_t>(h.prim)];
-        n_out[3 * i] = n.x;
-        n_out[3 * i + 1] = n.y;
-        n_out[3 * i + 2] = n.z;
+    std::shared_ptr<const BuiltScene> built;
+    const Accel* accel = structure(scene, rays.count, built);
+    // Ray i's answers from its hit (null: a miss).
+    auto write = [&](std::size_t i, const Hit* h) {
+      if (!h || h->prim < 0) {
+        t_out[i] = kInf;
+        g_out[i] = p_out[i] = kInvalidId;
+        uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
+        n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
+        return;
       }
-    });
+      t_out[i] = h->t;
+      built->locate(h->prim, g_out[i], p_out[i]);
+      uv_out[2 * i] = h->u;
+      uv_out[2 * i + 1] = h->v;
+      const glm::vec3& normal = built->normals[static_cast<std::size_t>(h->prim)];
+      n_out[3 * i] = normal.x;
+      n_out[3 * i + 1] = normal.y;
+      n_out[3 * i + 2] = normal.z;
+    };
+    if (!accel) {
+      for_parts(rays.count, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) write(i, nullptr);
+      });
+    } else {
+      ray_pipeline(
+          rays, tmin, tmax,
+          [&](Scratch& s, std::size_t, std::size_t n) {
+            accel->trace(Query::closest, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
+          },
+          [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
+            for_parts(n, [&](std::size_t begin, std::size_t end) {
+              for (std::size_t k = begin; k < end; ++k) write(first + k, &s.hits[k]);
+            }, parallel);
+          });
+    }
   }
   py::dict out;
   out["t_hit"] = t_hit;
@@ -128,15 +167,21 @@ py::array test_occlusions(const MeshScene& scene, py::handle rays_in, double tne
   bool* out = occluded.mutable_data();
   {
     py::gil_scoped_release release;
-    Traced traced = prepare_rays(scene, rays, tmin, tmax);
-    if (traced.empty()) {
-      std::memset(out, 0, rays.count);
+    std::shared_ptr<const BuiltScene> built;
+    const Accel* accel = structure(scene, rays.count, built);
+    if (!accel) {
+      std::fill(out, out + rays.count, false);
     } else {
-      std::vector<Hit> hits(rays.count);
-      traced.built->accel->trace(Query::any, Rays(traced.rays), hits, coherence_of(coherent));
-      for_parts(rays.count, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) out[i] = hits[i].prim >= 0;
-      });
+      ray_pipeline(
+          rays, tmin, tmax,
+          [&](Scratch& s, std::size_t, std::size_t n) {
+            accel->trace(Query::any, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
+          },
+          [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
+            for_parts(n, [&](std::size_t begin, std::size_t end) {
+              for (std::size_t k = begin; k < end; ++k) out[first + k] = s.hits[k].prim >= 0;
+            }, parallel);
+          });
     }
   }
   return occluded;
@@ -150,14 +195,20 @@ py::array count_intersections(const MeshScene& scene, py::handle rays_in, long l
   std::int32_t* out = counts.mutable_data();
   {
     py::gil_scoped_release release;
-    Traced traced = prepare_rays(scene, rays, 0.0f, kInf);
-    if (traced.empty()) {
-      std::memset(out, 0, rays.count * sizeof(std::int32_t));
+    std::shared_ptr<const BuiltScene> built;
+    const Accel* accel = structure(scene, rays.count, built);
+    if (!accel) {
+      std::fill(out, out + rays.count, 0);
     } else {
       // Counts of crossings are far below 2^31: the int32 array (Open3D's
       // dtype) holds the library's uint32 values unchanged.
-      traced.built->accel->count(Rays(traced.rays),
-                                 std::span<std::uint32_t>(reinterpret_cast<std::uint32_t*>(out), rays.count));
+      auto* counts_out = reinterpret_cast<std::uint32_t*>(out);
+      ray_pipeline(
+          rays, 0.0f, kInf,
+          [&](Scratch& s, std::size_t first, std::size_t n) {
+            accel->count(records(s, n), std::span<std::uint32_t>(counts_out + first, n));
+          },
+          kNothing);
     }
   }
   return counts;
@@ -167,13 +218,16 @@ py::dict list_intersections(const MeshScene& scene, py::handle rays_in, long lon
   const char* call = "list_intersections";
   check_nthreads(nthreads, call);
   const FloatRecords rays = float_records(rays_in, 6, call, "rays");
+  // One library call for all rays (its answer is one compressed list).
   AllHits all;
   std::shared_ptr<const BuiltScene> built;
   {
     py::gil_scoped_release release;
-    Traced traced = prepare_rays(scene, rays, 0.0f, kInf);
-    built = traced.built;
-    if (!traced.empty()) all = built->accel->all_hits(Rays(traced.rays));
+    if (const Accel* accel = structure(scene, rays.count, built)) {
+      HostArray<Ray> packed(rays.count);
+      pack_rays(rays, 0, 0.0f, kInf, packed);
+      all = accel->all_hits(Rays(std::span<const Ray>(packed)));
+    }
   }
   const std::size_t total = all.hits.size();
   if (total > 0xffffffffu)
@@ -221,20 +275,26 @@ py::dict list_intersections(const MeshScene& scene, py::handle rays_in, long lon
   return out;
 }
 
-// The points as 3 floats each and the structure over the meshes, or no
-// structure when there is nothing to query (no point, or no primitive).
-struct Queried {
+// compute_closest_points and compute_distance: the library's closest
+// points chunk by chunk, then write(built, first, n, hits, parallel); hits
+// is empty when the scene has nothing to hit.
+template <class Write>
+void closest_points(const MeshScene& scene, const FloatRecords& points, const char* call, Write&& write) {
+  check_points(points, call, "query_points");  // NaN and infinite points are refused, scene or not
   std::shared_ptr<const BuiltScene> built;
-  std::vector<float> xyz;
-  bool empty() const { return !built || !built->accel; }
-};
-
-Queried prepare_points(const MeshScene& scene, const FloatRecords& points, const char* call) {
-  Queried q;
-  q.xyz.resize(3 * points.count);
-  pack_points(points, q.xyz, call, "query_points");  // refuses NaN and infinite points, scene or not
-  if (points.count > 0) q.built = scene.snapshot();
-  return q;
+  const Accel* accel = structure(scene, points.count, built);
+  if (!accel) {
+    write(built.get(), 0, points.count, std::span<const PointHit>(), true);
+    return;
+  }
+  point_pipeline(
+      points,
+      [&](Scratch& s, std::size_t, std::size_t n) {
+        accel->closest_points(points_of(s, n), Scratch::first(s.point_hits, n));
+      },
+      [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
+        write(built.get(), first, n, std::span<const PointHit>(s.point_hits.data(), n), parallel);
+      });
 }
 
 py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, long long nthreads) {
@@ -253,31 +313,32 @@ py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, lo
   float* n_out = normals.mutable_data();
   {
     py::gil_scoped_release release;
-    Queried q = prepare_points(scene, points, call);
-    std::vector<PointHit> hits;
-    if (!q.empty()) hits = q.built->accel->closest_points(Points(std::span<const float>(q.xyz)));
-    const BuiltScene* built = q.built.get();
-    for_parts(points.count, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        if (hits.empty() || hits[i].prim < 0) {
-          c_out[3 * i] = c_out[3 * i + 1] = c_out[3 * i + 2] = kNaN;
-          g_out[i] = p_out[i] = kInvalidId;
-          uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
-          n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
-          continue;
+    closest_points(scene, points, call,
+                   [&](const BuiltScene* built, std::size_t first, std::size_t n, std::span<const PointHit> hits,
+                       bool parallel) {
+      for_parts(n, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) {
+          const std::size_t i = first + k;
+          if (hits.empty() || hits[k].prim < 0) {
+            c_out[3 * i] = c_out[3 * i + 1] = c_out[3 * i + 2] = kNaN;
+            g_out[i] = p_out[i] = kInvalidId;
+            uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
+            n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
+            continue;
+          }
+          const PointHit& h = hits[k];
+          c_out[3 * i] = h.x;
+          c_out[3 * i + 1] = h.y;
+          c_out[3 * i + 2] = h.z;
+          built->locate(h.prim, g_out[i], p_out[i]);
+          uv_out[2 * i] = h.u;
+          uv_out[2 * i + 1] = h.v;
+          const glm::vec3& normal = built->normals[static_cast<std::size_t>(h.prim)];
+          n_out[3 * i] = normal.x;
+          n_out[3 * i + 1] = normal.y;
+          n_out[3 * i + 2] = normal.z;
         }
-        const PointHit& h = hits[i];
-        c_out[3 * i] = h.x;
-        c_out[3 * i + 1] = h.y;
-        c_out[3 * i + 2] = h.z;
-        built->locate(h.prim, g_out[i], p_out[i]);
-        uv_out[2 * i] = h.u;
-        uv_out[2 * i + 1] = h.v;
-        const glm::vec3& n = built->normals[static_cast<std::size_t>(h.prim)];
-        n_out[3 * i] = n.x;
-        n_out[3 * i + 1] = n.y;
-        n_out[3 * i + 2] = n.z;
-      }
+      }, parallel);
     });
   }
   py::dict out;
@@ -289,28 +350,51 @@ py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, lo
   return out;
 }
 
-// compute_distance, compute_signed_distance, compute_occupancy: one float per
-// point from `query`, or `none` for every point when the scene has nothing
-// to hit.
-template <class Query>
-py::array point_values(const MeshScene& scene, py::handle points_in, long long nthreads, const char* call, float none,
-                       Query&& query) {
+py::array compute_distance(const MeshScene& scene, py::handle points_in, long long nthreads) {
+  const char* call = "compute_distance";
   check_nthreads(nthreads, call);
+  const FloatRecords points = float_records(points_in, 3, call, "query_points");
+  auto distance = output_array<float>(points.shape);
+  float* out = distance.mutable_data();
+  {
+    py::gil_scoped_release release;
+    closest_points(scene, points, call,
+                   [&](const BuiltScene*, std::size_t first, std::size_t n, std::span<const PointHit> hits,
+                       bool parallel) {
+      for_parts(n, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t k = begin; k < end; ++k) out[first + k] = hits.empty() ? kInf : hits[k].distance;
+      }, parallel);
+    });
+  }
+  return distance;
+}
+
+// compute_signed_distance and compute_occupancy: per chunk, query(accel,
+// points, out + first) writes n values, or `none` for every point when the
+// scene has nothing to hit.
+template <class Query>
+py::array inside_query(const MeshScene& scene, py::handle points_in, long long nthreads, long long nsamples,
+                       const char* call, float none, Query&& query) {
+  check_nthreads(nthreads, call);
+  const unsigned samples = check_nsamples(nsamples, call);
   const FloatRecords points = float_records(points_in, 3, call, "query_points");
   auto values = output_array<float>(points.shape);
   float* out = values.mutable_data();
   {
     py::gil_scoped_release release;
-    Queried q = prepare_points(scene, points, call);
-    if (q.empty()) {
+    check_points(points, call, "query_points");
+    std::shared_ptr<const BuiltScene> built;
+    const Accel* accel = structure(scene, points.count, built);
+    if (!accel) {
       std::fill(out, out + points.count, none);
     } else {
-      query(*q.built->accel, Points(std::span<const float>(q.xyz)), out);
+      point_pipeline(
+          points, [&](Scratch& s, std::size_t first, std::size_t n) { query(*accel, points_of(s, n), samples, out + first); },
+          kNothing);
     }
   }
   return values;
 }
-
 }  // namespace
 
 void bind_raycasting_scene(py::module_& m) {
@@ -389,25 +473,16 @@ and primitive_uvs (crossings, 2), rays counted over the flattened leading shape.
           R"doc(The nearest surface point of each query point ((..., 3) float32 or float64,
 finite). Returns a dict: points (..., 3), geometry_ids, primitive_ids (...)
 uint32, primitive_uvs (..., 2), primitive_normals (..., 3).)doc");
-  cls.def(
-      "compute_distance",
-      [](const MeshScene& scene, py::handle points, long long nthreads) {
-        return point_values(scene, points, nthreads, "compute_distance", kInf,
-                            [](const Accel& accel, const Points& p, float* out) {
-                              const std::vector<float> d = accel.distance(p);
-                              std::memcpy(out, d.data(), d.size() * sizeof(float));
-                            });
-      },
-      py::arg("query_points"), py::arg("nthreads") = 0,
-      R"doc(The distance of each query point to the surface: (...) float32.)doc");
+  cls.def("compute_distance", &compute_distance, py::arg("query_points"), py::arg("nthreads") = 0,
+          R"doc(The distance of each query point to the surface: (...) float32 (inf
+without triangles).)doc");
   cls.def(
       "compute_signed_distance",
       [](const MeshScene& scene, py::handle points, long long nthreads, long long nsamples) {
-        const unsigned n = check_nsamples(nsamples, "compute_signed_distance");
-        return point_values(scene, points, nthreads, "compute_signed_distance", kInf,
-                            [n](const Accel& accel, const Points& p, float* out) {
+        return inside_query(scene, points, nthreads, nsamples, "compute_signed_distance", kInf,
+                            [](const Accel& accel, const Points& p, unsigned n, float* out) {
                               const std::vector<float> d = accel.signed_distance(p, n);
-                              std::memcpy(out, d.data(), d.size() * sizeof(float));
+                              std::copy(d.begin(), d.end(), out);
                             });
       },
       py::arg("query_points"), py::arg("nthreads") = 0, py::arg("nsamples") = 1,
@@ -416,9 +491,8 @@ majority of nsamples (odd) rays' crossing parities.)doc");
   cls.def(
       "compute_occupancy",
       [](const MeshScene& scene, py::handle points, long long nthreads, long long nsamples) {
-        const unsigned n = check_nsamples(nsamples, "compute_occupancy");
-        return point_values(scene, points, nthreads, "compute_occupancy", 0.0f,
-                            [n](const Accel& accel, const Points& p, float* out) {
+        return inside_query(scene, points, nthreads, nsamples, "compute_occupancy", 0.0f,
+                            [](const Accel& accel, const Points& p, unsigned n, float* out) {
                               const std::vector<std::uint8_t> inside = accel.occupancy(p, n);
                               for (std::size_t i = 0; i < inside.size(); ++i) out[i] = inside[i] ? 1.0f : 0.0f;
                             });

@@ -284,3 +284,35 @@ def test_threads_adding_meshes_while_others_query():
         t.join()
     assert not errors, errors[0]
     assert scene.geometry_count == 6
+
+
+def test_calls_larger_than_one_chunk(cube):
+    """Calls of more rays or points than one library call takes (2^18) run
+    in chunks: every chunk's answers land in their places."""
+    n = 700_000
+    rays = down_rays(n, seed=4)
+    rays[123_456, 3:] = 0.0  # one miss, in the first chunk
+    rays[654_321, 0] = 5.0  # and one in the third, beside the cube
+    shaped = np.asfortranarray(rays).reshape(2, n // 2, 6, order="F")[:, ::-1]  # float64, strided
+    flat = shaped.reshape(-1, 6)
+    miss = ~((np.abs(flat[:, 0]) < 1.0) & (flat[:, 5] != 0.0))
+    assert miss.sum() == 2
+    ans = cube.cast_rays(shaped, coherent=True)
+    assert ans["t_hit"].shape == (2, n // 2)
+    t = ans["t_hit"].reshape(-1)
+    assert np.all(t[~miss] == 4.0) and np.all(t[miss] == np.inf)
+    assert np.array_equal(cube.test_occlusions(shaped).reshape(-1), ~miss)
+    assert np.array_equal(cube.count_intersections(shaped).reshape(-1), np.where(miss, 0, 2))
+    points = flat[:, :3] * np.array([1.0, 1.0, 0.2])  # on the plane z = 1
+    d = cube.compute_distance(points)
+    assert np.allclose(d[~miss], 0.0, atol=1e-6) and np.isclose(d[miss][1], 4.0)
+    closest = cube.compute_closest_points(points)["points"]
+    assert np.allclose(closest[~miss], points[~miss], atol=1e-6)
+    inside = points * np.array([1.0, 1.0, 0.5])
+    expected = np.all(np.abs(inside) < 1.0, axis=1).astype(np.float32)
+    assert expected.sum() == n - 1
+    assert np.array_equal(cube.compute_occupancy(inside), expected)
+    bad = points.copy()
+    bad[600_001, 1] = np.inf  # in the last chunk: refused before the first
+    with pytest.raises(ValueError, match=r"compute_distance: query_points\[600001\] has a NaN or infinite"):
+        cube.compute_distance(bad)
