@@ -7,6 +7,9 @@ packages=(
   opencl-headers opencl-clhpp-headers ocl-icd-opencl-dev pocl-opencl-icd clinfo
   libglm-dev libopenimageio-dev openimageio-tools libassimp-dev nlohmann-json3-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libembree-dev python3 python3-matplotlib
+  # the Python module (python/, CMake option RTCL_PYTHON) and its tests;
+  # python3-open3d is the tests' reference for point queries and camera rays
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-open3d
   # distributed render and bench under mpirun (CMake option RTCL_MPI)
   libopenmpi-dev openmpi-bin
   # fuzzing (scripts/fuzz.sh): clang with libFuzzer and the sanitizer
