@@ -61,15 +61,23 @@ inline float value(const char* record, py::ssize_t stride, int k) {
 }
 
 template <class T>
-void pack_rays_as(const FloatRecords& r, std::size_t first, float tmin, float tmax, std::span<Ray> out,
-                  bool parallel) {
+void pack_rays_as(const FloatRecords& r, std::size_t first, float tmin, float tmax, std::span<Ray> out, bool parallel) {
   const py::ssize_t s = r.value_stride;
-  for_parts(out.size(), [&](std::size_t begin, std::size_t end) {
-    walk(r, first + begin, first + end, [&](std::size_t i, const char* p) {
-      out[i - first] = Ray{value<T>(p, s, 0), value<T>(p, s, 1), value<T>(p, s, 2), value<T>(p, s, 3),
-                           value<T>(p, s, 4), value<T>(p, s, 5), tmin, tmax};
-    });
-  }, parallel);
+  for_parts(
+      out.size(),
+      [&](std::size_t begin, std::size_t end) {
+        walk(r, first + begin, first + end, [&](std::size_t i, const char* p) {
+          out[i - first] = Ray{value<T>(p, s, 0),
+                               value<T>(p, s, 1),
+                               value<T>(p, s, 2),
+                               value<T>(p, s, 3),
+                               value<T>(p, s, 4),
+                               value<T>(p, s, 5),
+                               tmin,
+                               tmax};
+        });
+      },
+      parallel);
 }
 
 std::string index_text(const std::vector<py::ssize_t>& shape, std::size_t flat) {
@@ -87,14 +95,17 @@ std::string index_text(const std::vector<py::ssize_t>& shape, std::size_t flat) 
 template <class T>
 void pack_points_as(const FloatRecords& r, std::size_t first, std::span<float> out, bool parallel) {
   const py::ssize_t s = r.value_stride;
-  for_parts(out.size() / 3, [&](std::size_t begin, std::size_t end) {
-    walk(r, first + begin, first + end, [&](std::size_t i, const char* p) {
-      float* o = &out[3 * (i - first)];
-      o[0] = value<T>(p, s, 0);
-      o[1] = value<T>(p, s, 1);
-      o[2] = value<T>(p, s, 2);
-    });
-  }, parallel);
+  for_parts(
+      out.size() / 3,
+      [&](std::size_t begin, std::size_t end) {
+        walk(r, first + begin, first + end, [&](std::size_t i, const char* p) {
+          float* o = &out[3 * (i - first)];
+          o[0] = value<T>(p, s, 0);
+          o[1] = value<T>(p, s, 1);
+          o[2] = value<T>(p, s, 2);
+        });
+      },
+      parallel);
 }
 
 // The first point with a coordinate that is not finite as a float, or
@@ -174,8 +185,7 @@ FloatRecords float_records(py::handle object, int width, const char* call, const
   return r;
 }
 
-void pack_rays(const FloatRecords& rays, std::size_t first, float tmin, float tmax, std::span<Ray> out,
-               bool parallel) {
+void pack_rays(const FloatRecords& rays, std::size_t first, float tmin, float tmax, std::span<Ray> out, bool parallel) {
   if (rays.float64)
     pack_rays_as<double>(rays, first, tmin, tmax, out, parallel);
   else

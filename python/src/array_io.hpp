@@ -8,17 +8,17 @@
 // numpy.asarray accepts (lists, ...) is converted by numpy first.
 #pragma once
 
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <functional>
+#include <glm/glm.hpp>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
-#include <pybind11/numpy.h>
-#include <pybind11/pybind11.h>
 
 #include "rtcl/queries.hpp"
 
@@ -28,13 +28,13 @@ namespace py = pybind11;
 
 // An input array read as records of `width` floats along its last axis.
 struct FloatRecords {
-  py::array array;                        // holds the data
+  py::array array;  // holds the data
   const char* data = nullptr;
-  bool float64 = false;                   // else float32
-  std::vector<py::ssize_t> shape;         // the leading shape (the record axis left out)
-  std::vector<py::ssize_t> strides;       // bytes per step along each leading axis
-  py::ssize_t value_stride = 0;           // bytes between a record's values
-  std::size_t count = 0;                  // records: the product of `shape`
+  bool float64 = false;              // else float32
+  std::vector<py::ssize_t> shape;    // the leading shape (the record axis left out)
+  std::vector<py::ssize_t> strides;  // bytes per step along each leading axis
+  py::ssize_t value_stride = 0;      // bytes between a record's values
+  std::size_t count = 0;             // records: the product of `shape`
 };
 
 // Checks `object` as an array of records of `width` values (GIL held):

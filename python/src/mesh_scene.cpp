@@ -49,13 +49,9 @@ std::uint32_t MeshScene::add_triangles(std::vector<glm::vec3> vertices, std::vec
   if (meshes_.size() >= kInvalidId - 1 || prims + mesh->triangles.size() > 0x7fffffffu)
     throw Error("add_triangles: the scene would hold more than 2^31-1 triangles or 2^32-2 meshes");
   meshes_.push_back(std::move(mesh));
+  geometry_count_.store(meshes_.size());
   built_.reset();
   return static_cast<std::uint32_t>(meshes_.size() - 1);
-}
-
-std::size_t MeshScene::geometry_count() const {
-  std::lock_guard lock(mutex_);
-  return meshes_.size();
 }
 
 std::shared_ptr<const BuiltScene> MeshScene::snapshot() const {

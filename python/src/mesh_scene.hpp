@@ -10,13 +10,13 @@
 // structure only through snapshot().
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 #include "rtcl/accel.hpp"
 #include "rtcl/device.hpp"
@@ -30,10 +30,10 @@ inline constexpr std::uint32_t kInvalidId = 0xffffffffu;
 
 // What queries run on: immutable once built, shared by the calls in flight.
 struct BuiltScene {
-  Geometry geometry;                       // every mesh, in geometry id order
-  std::vector<std::uint32_t> first_prim;   // mesh g: prims [first_prim[g], first_prim[g + 1])
-  std::vector<glm::vec3> normals;          // unit face normal of each triangle, (v1 - v0) x (v2 - v0)
-  std::unique_ptr<Accel> accel;            // null when nothing can be hit (no mesh, or only zero-area triangles)
+  Geometry geometry;                      // every mesh, in geometry id order
+  std::vector<std::uint32_t> first_prim;  // mesh g: prims [first_prim[g], first_prim[g + 1])
+  std::vector<glm::vec3> normals;         // unit face normal of each triangle, (v1 - v0) x (v2 - v0)
+  std::unique_ptr<Accel> accel;           // null when nothing can be hit (no mesh, or only zero-area triangles)
 
   // The mesh and its triangle of merged primitive `prim` (>= 0).
   void locate(std::int32_t prim, std::uint32_t& geometry_id, std::uint32_t& primitive_id) const;
@@ -56,7 +56,8 @@ class MeshScene {
   // wait for it). Thread-safe.
   std::shared_ptr<const BuiltScene> snapshot() const;
 
-  std::size_t geometry_count() const;
+  // The meshes added so far (never waits for a build in progress).
+  std::size_t geometry_count() const { return geometry_count_.load(); }
   const Device& device() const { return device_; }
   const std::string& accel_spec() const { return accel_; }
   const AccelConfig& config() const { return config_; }
@@ -71,6 +72,7 @@ class MeshScene {
   AccelConfig config_;
   mutable std::mutex mutex_;
   std::vector<std::shared_ptr<const Mesh>> meshes_;
+  std::atomic<std::size_t> geometry_count_{0};
   mutable std::shared_ptr<const BuiltScene> built_;  // null after a change
 };
 

@@ -24,8 +24,8 @@ PYBIND11_MODULE(rtcl, m) {
     } catch (const rtcl::Error& e) {
       PyErr_SetString(PyExc_RuntimeError, e.what());
     } catch (const cl::Error& e) {
-      PyErr_SetString(PyExc_RuntimeError, (std::string(e.what()) + " failed: OpenCL error " +
-                                           std::to_string(e.err())).c_str());
+      PyErr_SetString(PyExc_RuntimeError,
+                      (std::string(e.what()) + " failed: OpenCL error " + std::to_string(e.err())).c_str());
     }
   });
   rtcl::python::bind_devices(m);

@@ -3,9 +3,8 @@
 // array in pixel order (row 0 first), directions not normalised: pixel
 // (x, y) looks through image point (x + 0.5, y + 0.5, 1) of the camera.
 #include <cmath>
-#include <string>
-
 #include <glm/glm.hpp>
+#include <string>
 
 #include "array_io.hpp"
 #include "raycasting_scene.hpp"

@@ -13,10 +13,10 @@
 #include "array_io.hpp"
 #include "devices.hpp"
 #include "mesh_scene.hpp"
-#include "scratch.hpp"
 #include "rtcl/accel_options.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/precision.hpp"
+#include "scratch.hpp"
 
 namespace rtcl::python {
 
@@ -142,9 +142,12 @@ py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthread
             accel->trace(Query::closest, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
           },
           [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
-            for_parts(n, [&](std::size_t begin, std::size_t end) {
-              for (std::size_t k = begin; k < end; ++k) write(first + k, &s.hits[k]);
-            }, parallel);
+            for_parts(
+                n,
+                [&](std::size_t begin, std::size_t end) {
+                  for (std::size_t k = begin; k < end; ++k) write(first + k, &s.hits[k]);
+                },
+                parallel);
           });
     }
   }
@@ -178,9 +181,12 @@ py::array test_occlusions(const MeshScene& scene, py::handle rays_in, double tne
             accel->trace(Query::any, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
           },
           [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
-            for_parts(n, [&](std::size_t begin, std::size_t end) {
-              for (std::size_t k = begin; k < end; ++k) out[first + k] = s.hits[k].prim >= 0;
-            }, parallel);
+            for_parts(
+                n,
+                [&](std::size_t begin, std::size_t end) {
+                  for (std::size_t k = begin; k < end; ++k) out[first + k] = s.hits[k].prim >= 0;
+                },
+                parallel);
           });
     }
   }
@@ -313,33 +319,36 @@ py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, lo
   float* n_out = normals.mutable_data();
   {
     py::gil_scoped_release release;
-    closest_points(scene, points, call,
-                   [&](const BuiltScene* built, std::size_t first, std::size_t n, std::span<const PointHit> hits,
-                       bool parallel) {
-      for_parts(n, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) {
-          const std::size_t i = first + k;
-          if (hits.empty() || hits[k].prim < 0) {
-            c_out[3 * i] = c_out[3 * i + 1] = c_out[3 * i + 2] = kNaN;
-            g_out[i] = p_out[i] = kInvalidId;
-            uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
-            n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
-            continue;
-          }
-          const PointHit& h = hits[k];
-          c_out[3 * i] = h.x;
-          c_out[3 * i + 1] = h.y;
-          c_out[3 * i + 2] = h.z;
-          built->locate(h.prim, g_out[i], p_out[i]);
-          uv_out[2 * i] = h.u;
-          uv_out[2 * i + 1] = h.v;
-          const glm::vec3& normal = built->normals[static_cast<std::size_t>(h.prim)];
-          n_out[3 * i] = normal.x;
-          n_out[3 * i + 1] = normal.y;
-          n_out[3 * i + 2] = normal.z;
-        }
-      }, parallel);
-    });
+    closest_points(
+        scene, points, call,
+        [&](const BuiltScene* built, std::size_t first, std::size_t n, std::span<const PointHit> hits, bool parallel) {
+          for_parts(
+              n,
+              [&](std::size_t begin, std::size_t end) {
+                for (std::size_t k = begin; k < end; ++k) {
+                  const std::size_t i = first + k;
+                  if (hits.empty() || hits[k].prim < 0) {
+                    c_out[3 * i] = c_out[3 * i + 1] = c_out[3 * i + 2] = kNaN;
+                    g_out[i] = p_out[i] = kInvalidId;
+                    uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
+                    n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
+                    continue;
+                  }
+                  const PointHit& h = hits[k];
+                  c_out[3 * i] = h.x;
+                  c_out[3 * i + 1] = h.y;
+                  c_out[3 * i + 2] = h.z;
+                  built->locate(h.prim, g_out[i], p_out[i]);
+                  uv_out[2 * i] = h.u;
+                  uv_out[2 * i + 1] = h.v;
+                  const glm::vec3& normal = built->normals[static_cast<std::size_t>(h.prim)];
+                  n_out[3 * i] = normal.x;
+                  n_out[3 * i + 1] = normal.y;
+                  n_out[3 * i + 2] = normal.z;
+                }
+              },
+              parallel);
+        });
   }
   py::dict out;
   out["points"] = closest;
@@ -358,13 +367,16 @@ py::array compute_distance(const MeshScene& scene, py::handle points_in, long lo
   float* out = distance.mutable_data();
   {
     py::gil_scoped_release release;
-    closest_points(scene, points, call,
-                   [&](const BuiltScene*, std::size_t first, std::size_t n, std::span<const PointHit> hits,
-                       bool parallel) {
-      for_parts(n, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) out[first + k] = hits.empty() ? kInf : hits[k].distance;
-      }, parallel);
-    });
+    closest_points(
+        scene, points, call,
+        [&](const BuiltScene*, std::size_t first, std::size_t n, std::span<const PointHit> hits, bool parallel) {
+          for_parts(
+              n,
+              [&](std::size_t begin, std::size_t end) {
+                for (std::size_t k = begin; k < end; ++k) out[first + k] = hits.empty() ? kInf : hits[k].distance;
+              },
+              parallel);
+        });
   }
   return distance;
 }
@@ -389,7 +401,8 @@ py::array inside_query(const MeshScene& scene, py::handle points_in, long long n
       std::fill(out, out + points.count, none);
     } else {
       point_pipeline(
-          points, [&](Scratch& s, std::size_t first, std::size_t n) { query(*accel, points_of(s, n), samples, out + first); },
+          points,
+          [&](Scratch& s, std::size_t first, std::size_t n) { query(*accel, points_of(s, n), samples, out + first); },
           kNothing);
     }
   }
@@ -428,8 +441,9 @@ nthreads: accepted as Open3D's (>= 0) and ignored: the device sets the threads.
           }),
           py::kw_only(), py::arg("device") = py::none(), py::arg("accel") = "bvh", py::arg("precision") = "robust",
           py::arg("nthreads") = 0);
-  cls.def_property_readonly_static("INVALID_ID", [](py::object) { return kInvalidId; },
-                                   "The geometry and primitive id of a miss: 2^32 - 1, as Open3D's.");
+  cls.def_property_readonly_static(
+      "INVALID_ID", [](py::object) { return kInvalidId; },
+      "The geometry and primitive id of a miss: 2^32 - 1, as Open3D's.");
   cls.def(
       "add_triangles",
       [](MeshScene& scene, py::handle vertex_positions, py::handle triangle_indices) {
@@ -505,8 +519,8 @@ compute_signed_distance's sign.)doc");
   cls.def("__repr__", [](const MeshScene& scene) {
     return "rtcl.RaycastingScene(device=" + py::repr(py::str(scene.device().info().name)).cast<std::string>() +
            ", accel=" + py::repr(py::str(scene.accel_spec())).cast<std::string>() + ", precision='" +
-           std::string(precision_name(scene.config().precision)) + "', meshes=" +
-           std::to_string(scene.geometry_count()) + ")";
+           std::string(precision_name(scene.config().precision)) +
+           "', meshes=" + std::to_string(scene.geometry_count()) + ")";
   });
   bind_pinhole(cls);
 }

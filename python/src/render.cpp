@@ -2,13 +2,13 @@
 // float32, linear RGB, rows from the top. The options are the command's
 // (docs/cli.md, src/cli/render_command.cpp) under Python names; the scene is
 // a built-in scene's name or a scene file.
+#include <pybind11/stl.h>
+
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
-
-#include <pybind11/stl.h>
 
 #include "array_io.hpp"
 #include "devices.hpp"
@@ -98,8 +98,7 @@ Scene read_scene(py::handle scene) {
   }
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    throw py::value_error("render: scene \"" + path +
-                          "\": no such file (built-in scenes: default, showcase)");
+    throw py::value_error("render: scene \"" + path + "\": no such file (built-in scenes: default, showcase)");
   return as_value_error([&] { return load_scene(path); });
 }
 
@@ -175,8 +174,8 @@ void bind_render(py::module_& m) {
       [](py::handle scene_arg, long long width, py::object height, long long spp, long long depth,
          const std::string& sampler, long long seed, const std::string& filter, long long light_samples,
          double min_weight, const std::string& method, long long selective_block, double selective_threshold,
-         double selective_depth, double wavelet_budget, const std::string& beam_order,
-         std::optional<std::string> accel, std::optional<std::string> precision, py::handle device, long long batch) {
+         double selective_depth, double wavelet_budget, const std::string& beam_order, std::optional<std::string> accel,
+         std::optional<std::string> precision, py::handle device, long long batch) {
         RenderArgs a;
         a.width = width;
         a.height = height.is_none() ? 0 : height.cast<long long>();
@@ -205,18 +204,17 @@ void bind_render(py::module_& m) {
         }
         const Device opened = open_device(device);
         const Image image = render_image(opened, scene, a);
-        auto out = output_array<float>({static_cast<py::ssize_t>(image.height), static_cast<py::ssize_t>(image.width)},
-                                       {3});
+        auto out =
+            output_array<float>({static_cast<py::ssize_t>(image.height), static_cast<py::ssize_t>(image.width)}, {3});
         std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
         return out;
       },
       py::arg("scene") = py::none(), py::arg("width") = 512, py::arg("height") = py::none(), py::arg("spp") = 1,
       py::kw_only(), py::arg("depth") = 5, py::arg("sampler") = "stratified", py::arg("seed") = 0,
-      py::arg("filter") = "box", py::arg("light_samples") = 1, py::arg("min_weight") = 1e-3,
-      py::arg("method") = "ray", py::arg("selective_block") = 8, py::arg("selective_threshold") = 0.05,
-      py::arg("selective_depth") = 0.1, py::arg("wavelet_budget") = 0.25, py::arg("beam_order") = "exact",
-      py::arg("accel") = py::none(), py::arg("precision") = py::none(), py::arg("device") = py::none(),
-      py::arg("batch") = 1 << 17,
+      py::arg("filter") = "box", py::arg("light_samples") = 1, py::arg("min_weight") = 1e-3, py::arg("method") = "ray",
+      py::arg("selective_block") = 8, py::arg("selective_threshold") = 0.05, py::arg("selective_depth") = 0.1,
+      py::arg("wavelet_budget") = 0.25, py::arg("beam_order") = "exact", py::arg("accel") = py::none(),
+      py::arg("precision") = py::none(), py::arg("device") = py::none(), py::arg("batch") = 1 << 17,
       R"doc(Renders a scene as `rtcl render` does and returns the image: (height, width, 3)
 float32, linear RGB, row 0 at the top.
 
