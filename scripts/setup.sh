@@ -20,8 +20,8 @@ packages=(
 if [ "$render_only" -eq 0 ]; then
   packages+=(
     openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev libembree-dev python3 python3-matplotlib
-    # the Python module (python/): bindings, its tests, and Open3D as their
-    # distance reference and yardstick
+    # the Python module (python/, CMake option RTCL_PYTHON) and its tests;
+    # python3-open3d is the tests' reference for point queries and camera rays
     python3-dev python3-numpy pybind11-dev python3-pytest python3-open3d
     # distributed render and bench under mpirun (CMake option RTCL_MPI)
     libopenmpi-dev openmpi-bin

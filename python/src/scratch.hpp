@@ -1,0 +1,72 @@
+// Host arrays a query call converts into and the library answers into,
+// kept between calls: a fresh array of 4 KiB pages costs a page fault per
+// page at its first touch (on a virtual machine about 100 ms per 1M rays'
+// records, as long as the trace itself), so calls lease arrays from a pool
+// that keeps them. Calls run chunk by chunk (pipeline), so that a leased
+// set stays small and the conversions of one chunk overlap the device work
+// of the next.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "rtcl/default_init_allocator.hpp"
+#include "rtcl/queries.hpp"
+
+namespace rtcl::python {
+
+// Rays or points per library call when a call is split: enough that a
+// call's fixed costs stay small, few enough that the conversions of the
+// first and last chunk, which nothing overlaps, are short.
+inline constexpr std::size_t kChunk = std::size_t{1} << 18;
+
+// Not zeroed when grown, and advised for huge pages (rtcl/huge_pages.hpp).
+template <class T>
+using HostArray = std::vector<T, DefaultInitAllocator<T>>;
+
+struct Scratch {
+  HostArray<Ray> rays;
+  HostArray<Hit> hits;
+  HostArray<float> xyz;
+  HostArray<PointHit> point_hits;
+
+  // The first n elements of an array, grown to hold them.
+  template <class T>
+  static std::span<T> first(HostArray<T>& array, std::size_t n) {
+    if (array.size() < n) array.resize(n);
+    return std::span<T>(array.data(), n);
+  }
+};
+
+// One Scratch for the lifetime of the lease, from the process-wide pool
+// (thread-safe: each concurrent call holds its own).
+class ScratchLease {
+ public:
+  ScratchLease();
+  ~ScratchLease();
+  ScratchLease(const ScratchLease&) = delete;
+  ScratchLease& operator=(const ScratchLease&) = delete;
+  Scratch& operator*() { return *scratch_; }
+  Scratch* operator->() { return scratch_.get(); }
+
+ private:
+  std::unique_ptr<Scratch> scratch_;
+};
+
+// Runs [0, count) chunk by chunk ([first, first + n), n <= kChunk) through
+// pack(slot, first, n, parallel), run(slot, first, n) and
+// unpack(slot, first, n, parallel), where slot (0 or 1) names one of two
+// sets of scratch arrays. run(k) on the calling thread (the device work)
+// overlaps unpack(k - 1) and pack(k + 1) on another host thread
+// (rtcl/thread_pool.hpp), which then run serially (parallel = false); the
+// first pack and the last unpack, overlapping nothing, may use every host
+// thread. The exception of the lowest job that throws is rethrown after the
+// chunk's jobs have returned.
+void pipeline(std::size_t count, const std::function<void(int, std::size_t, std::size_t, bool)>& pack,
+              const std::function<void(int, std::size_t, std::size_t)>& run,
+              const std::function<void(int, std::size_t, std::size_t, bool)>& unpack);
+
+}  // namespace rtcl::python

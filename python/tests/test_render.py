@@ -1,0 +1,122 @@
+"""rtcl.render: the image of `rtcl render` as a numpy array. The renderer
+itself is tested by the C++ suite; here, that the options reach it: the
+array is the image the command writes for the same options (an 8-bit PNG,
+read here with zlib), and bad options are refused."""
+import os
+import struct
+import subprocess
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rtcl
+
+
+def read_png(path):
+    """An 8-bit RGB or RGBA PNG file as (height, width, 3) uint8 (zlib and
+    the five row filters of the PNG specification)."""
+    data = Path(path).read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    pos, idat = 8, b""
+    while pos < len(data):
+        length, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
+            assert depth == 8 and colour in (2, 6) and interlace == 0
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    channels = 3 if colour == 2 else 4
+    raw = zlib.decompress(idat)
+    stride = width * channels
+    out = np.zeros((height, stride), np.int32)
+    for y in range(height):
+        kind, row = raw[y * (stride + 1)], np.frombuffer(raw, np.uint8, stride, y * (stride + 1) + 1).astype(np.int32)
+        up = out[y - 1] if y else np.zeros(stride, np.int32)
+        if kind in (0, 2):
+            out[y] = (row + (up if kind == 2 else 0)) & 255
+            continue
+        for x in range(stride):
+            left = out[y, x - channels] if x >= channels else 0
+            corner = up[x - channels] if x >= channels else 0
+            if kind == 1:
+                pred = left
+            elif kind == 3:
+                pred = (left + up[x]) // 2
+            else:  # Paeth
+                p = left + up[x] - corner
+                pa, pb, pc = abs(p - left), abs(p - up[x]), abs(p - corner)
+                pred = left if pa <= pb and pa <= pc else up[x] if pb <= pc else corner
+            out[y, x] = (row[x] + pred) & 255
+    return out.reshape(height, width, channels)[..., :3].astype(np.uint8)
+
+
+def srgb_bytes(linear):
+    """The 8-bit sRGB values the tool writes for a linear image."""
+    c = np.clip(linear.astype(np.float64), 0.0, 1.0)
+    encoded = np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1.0 / 2.4) - 0.055)
+    return np.rint(encoded * 255.0).astype(np.int32)
+
+
+def test_default_scene():
+    image = rtcl.render(width=48, spp=1, depth=2)
+    assert image.dtype == np.float32 and image.ndim == 3 and image.shape[1:] == (48, 3)
+    assert np.all(np.isfinite(image)) and np.all(image >= 0)
+    assert image.mean() > 0.01  # something is lit
+    assert rtcl.render("default", 32, 24, depth=0).shape == (24, 32, 3)
+
+
+@pytest.mark.skipif(not os.environ.get("RTCL_CLI"), reason="RTCL_CLI (the rtcl tool) not given")
+@pytest.mark.parametrize("options", [
+    dict(scene="showcase", width=40, height=30, spp=2, depth=3, sampler="sobol", seed=7, light_samples=2),
+    dict(scene="default", width=40, height=32, spp=1, method="selective", selective_block=4),
+])
+def test_same_image_as_the_command(tmp_path, options):
+    out = tmp_path / "image.png"
+    args = [os.environ["RTCL_CLI"], "render", "-q", "-o", str(out)]
+    for key, value in options.items():
+        args += ["--builtin", value] if key == "scene" else [f"--{key.replace('_', '-')}", str(value)]
+    subprocess.run(args, check=True, capture_output=True)
+    image = rtcl.render(**options)
+    assert image.shape == (options["height"], options["width"], 3)
+    # The same linear values, up to the rounding of the sRGB encoding.
+    difference = np.abs(srgb_bytes(image) - read_png(out).astype(np.int32))
+    assert difference.max() <= 1 and difference.mean() < 0.01
+    # ... which tells these options apart.
+    other = rtcl.render(**{**options, "seed": 99, "spp": 3})
+    assert np.abs(srgb_bytes(other) - read_png(out).astype(np.int32)).max() > 8
+
+
+def test_bad_options():
+    with pytest.raises(ValueError, match=r"render: width is 0; must be in \[1, 65536\]"):
+        rtcl.render(width=0)
+    with pytest.raises(ValueError, match="render: spp is 0"):
+        rtcl.render(spp=0)
+    with pytest.raises(ValueError, match="render: sampler is 'halton'; must be one of"):
+        rtcl.render(sampler="halton")
+    with pytest.raises(ValueError, match="render: method is 'cone'"):
+        rtcl.render(method="cone")
+    with pytest.raises(ValueError, match="render: min_weight"):
+        rtcl.render(min_weight=float("nan"))
+    with pytest.raises(ValueError, match='render: scene "no/such.json": no such file'):
+        rtcl.render("no/such.json")
+    with pytest.raises(TypeError, match="render: scene must be"):
+        rtcl.render(3)
+    with pytest.raises(ValueError, match='accel "nope"'):
+        rtcl.render(width=8, accel="nope")
+    with pytest.raises(ValueError, match='precision "nope"'):
+        rtcl.render(width=8, precision="nope")
+
+
+def test_scene_file(tmp_path):
+    scene = tmp_path / "scene.json"
+    scene.write_text('{"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0], "fov": 40},'
+                     ' "lights": [{"position": [2, 2, 2]}], "materials": {"white": {}},'
+                     ' "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "white"}]}')
+    image = rtcl.render(scene, 16, 16)
+    assert image.shape == (16, 16, 3)
+    assert image[8, 8].sum() > image[0, 0].sum()  # the sphere in the middle, lit
+    assert np.array_equal(rtcl.render(os.fspath(scene), 16, 16), rtcl.render(scene, 16, 16))
