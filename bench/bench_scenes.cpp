@@ -140,11 +140,6 @@ std::string repo_scene(const std::string& name) {
   return std::string(RTCL_BENCH_REPO_SCENES) + "/" + name;
 }
 
-std::string scenes_dir() {
-  if (const char* dir = std::getenv("RTCL_SCENES_DIR"); dir && *dir) return dir;
-  return RTCL_BENCH_SCENES_DIR;
-}
-
 int image_size() { return static_cast<int>(env_number("RTCL_BENCH_RES", 1024, 1)); }
 
 std::size_t brute_ray_limit() { return static_cast<std::size_t>(env_number("RTCL_BENCH_BRUTE_RAYS", 16384, 1)); }

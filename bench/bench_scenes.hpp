@@ -14,6 +14,7 @@
 
 #include "rtcl/accel.hpp"
 #include "bench/support/scene_catalog.hpp"
+#include "bench/support/scenes_dir.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/layouts.hpp"
 #include "rtcl/geometry.hpp"
@@ -37,10 +38,8 @@ inline constexpr RayKind ordered_ray_kinds[] = {RayKind::primary_tiled, RayKind:
 const char* ray_kind_name(RayKind kind);
 Query ray_kind_query(RayKind kind);
 
-// Camera, SceneSpec and scene_specs(): bench/support/scene_catalog.hpp.
-
-// $RTCL_SCENES_DIR, else the ../shared/scenes beside the source tree.
-std::string scenes_dir();
+// Camera, SceneSpec and scene_specs(): bench/support/scene_catalog.hpp;
+// scenes_dir(): bench/support/scenes_dir.hpp.
 
 // The repository's scene file scenes/<name> (their mesh paths point at
 // ../shared/scenes).

@@ -141,7 +141,7 @@ TEST(BeamRender, CommandLine) {
                  "--method beam traces polygons only, and the scene has 2 sphere(s)", dir, "s.png");
   expect_failure(run_cli(dir, {"render", scenes + "cornell_beam.json", "--method", "beam", "--frames", "0:1", "-o",
                                 "f%d.png", "--width", "16"}),
-                 "--frames: not with --method beam", dir, "f0.png");
+                 "--frames: not with --method beam", dir, "f0.png", 2);
   expect_usage_error(run_cli(dir, {"render", "--method", "cone", "-o", "x.png"}), "--method");
   expect_usage_error(run_cli(dir, {"render", "--method", "beam", "--beam-order", "random", "-o", "x.png"}),
                      "--beam-order");

@@ -12,12 +12,13 @@
 #include <nlohmann/json.hpp>
 
 #include "support/cli_run.hpp"
+#include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 
 namespace rtcl::test {
 namespace {
 
-std::string scenes_env() { return std::string("RTCL_SCENES_DIR=") + shell_quoted(RTCL_SCENE_DIR); }
+std::string scenes_env() { return "RTCL_SCENES_DIR=" + shell_quoted(scenes_dir()); }
 
 TEST(CliBench, SmokeRunWritesACompleteMatrix) {
   TempDir dir;
@@ -156,7 +157,8 @@ TEST(CliBench, DiffuseSortAlwaysSortsOnlyTheDiffuseCellsThatCan) {
   CliRun bad = run_cli(dir, {"bench", "--size", "32", "--diffuse-sort", "sometimes", "-o", dir.file("out")},
                        scenes_env());
   EXPECT_NE(bad.status, 0);
-  EXPECT_NE(bad.err.find("--diffuse-sort sometimes: unknown (known: measured, always, never)"), std::string::npos)
+  EXPECT_NE(bad.err.find("--diffuse-sort sometimes: unknown sort policy (known: measured, always, never)"),
+            std::string::npos)
       << bad.err;
 }
 

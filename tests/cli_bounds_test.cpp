@@ -57,7 +57,7 @@ TEST(CliBounds, BadInputIsOneErrorLine) {
   expect_failure(run_cli(dir, {"bounds", empty}), "empty.obj", dir);
   std::string nan = dir.write("nan.obj", "v 0 0 0\nv 1 0 0\nv nan 1 0\nf 1 2 3\n");
   expect_failure(run_cli(dir, {"bounds", nan}), "nan.obj", dir);
-  expect_usage_error(run_cli(dir, {"bounds"}), "MESH is required");
+  expect_usage_error(run_cli(dir, {"bounds"}), "MESH: missing (required)");
 }
 
 }  // namespace

@@ -15,13 +15,14 @@
 #include <nlohmann/json.hpp>
 
 #include "support/cli_run.hpp"
+#include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 
 namespace rtcl::test {
 namespace {
 
 std::string rank_env() {
-  return mpi_rank_env(std::string("RTCL_SCENES_DIR=") + shell_quoted(RTCL_SCENE_DIR));
+  return mpi_rank_env("RTCL_SCENES_DIR=" + shell_quoted(scenes_dir()));
 }
 
 using Key = std::tuple<std::string, std::string, std::string>;

@@ -451,7 +451,7 @@ TEST(RenderCommand, FailuresExitNonZeroAndLeaveNoImage) {
   EXPECT_EQ(read_text(dir.file("old.png")), "previous content") << "a failed render keeps the old file";
 
   r = rtcl(dir, "render -o out.unknownformat --width 8");
-  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.status, 2);  // a bad command line
   EXPECT_NE(r.err.find("out.unknownformat"), std::string::npos) << r.err;
   r = rtcl(dir, "render -o out.png --width 8 --accel nonsense");
   EXPECT_NE(r.status, 0);

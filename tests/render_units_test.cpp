@@ -97,7 +97,7 @@ TEST(RenderUnits, BadRangesListsAndPatternsAreOneClearError) {
   };
   for (const Bad& c : cases) {
     CliRun run = run_cli(dir, args(c.scene, c.output, c.options));
-    expect_failure(run, c.fragment, dir);
+    expect_failure(run, c.fragment, dir, "", 2);  // a bad command line
     for (const auto& name : dir.entries())
       EXPECT_TRUE(name.rfind(".json") == name.size() - 5) << c.fragment << ": left " << name;
   }

@@ -68,7 +68,7 @@ TEST(Showcase, RendersFromTheCommandLineWithNoFiles) {
   float peak = *std::max_element(image.rgb.begin(), image.rgb.end());
   EXPECT_GT(peak, 0.1f);
   CliRun both = run_cli(dir, {"render", dir.write("s.json", "{}"), "--builtin", "showcase", "-o", out});
-  expect_failure(both, "not both", dir);
+  expect_failure(both, "not both", dir, "", 2);
   expect_usage_error(run_cli(dir, {"render", "--builtin", "nothing", "-o", out}), "--builtin");
 }
 

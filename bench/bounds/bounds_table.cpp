@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/support/scenes_dir.hpp"
 #include "rtcl/bounds/bounds_report.hpp"
 #include "rtcl/bounds/point_input.hpp"
 #include "rtcl/bounds/volume_rays.hpp"
@@ -81,8 +82,7 @@ Row measure(const std::string& name, const std::vector<glm::vec3>& points, const
 int main(int argc, char** argv) {
   std::size_t rays = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 2000;
   std::size_t cloud_points = argc > 2 ? std::strtoul(argv[2], nullptr, 10) : 20000;
-  const char* dir_env = std::getenv("RTCL_SCENES_DIR");
-  std::filesystem::path dir = dir_env ? dir_env : RTCL_BENCH_SCENES_DIR;
+  std::filesystem::path dir = rtcl::bench::scenes_dir();
   std::vector<std::filesystem::path> meshes;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(dir)) {
     std::string ext = entry.path().extension().string();

@@ -25,6 +25,7 @@
 #include <thread>
 #include <vector>
 
+#include "bench/support/scenes_dir.hpp"
 #include "rtcl/accel.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/scene/mesh_io.hpp"
@@ -219,7 +220,7 @@ int main(int argc, char** argv) {
     RTCDevice embree = rtcNewDevice(config.c_str());
     if (!embree) throw rtcl::Error("Embree: rtcNewDevice failed");
     std::printf("device: %s; %zu points, median of %d runs after a warm-up\n", device.info().name.c_str(), n, runs);
-    const std::string dir = RTCL_CLOSEST_BENCH_SCENES_DIR;
+    const std::string dir = rtcl::bench::scenes_dir();
     for (const char* scene : {"stanford_bunny/bunny.obj", "stanford_dragon_100k/dragon.obj"})
       run_scene(device, embree, dir + "/" + scene, n, runs, threads);
     rtcReleaseDevice(embree);

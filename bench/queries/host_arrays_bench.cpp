@@ -26,6 +26,7 @@
 
 #include "bench/support/ray_sets.hpp"
 #include "bench/support/scene_catalog.hpp"
+#include "bench/support/scenes_dir.hpp"
 #include "rtcl/rtcl.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #ifdef RTCL_HAVE_EMBREE
@@ -58,7 +59,7 @@ std::vector<std::string> split(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) try {
-  std::string scenes_dir = RTCL_BENCH_SCENES_DIR, scenes = "bunny,dragon,sponza";
+  std::string scenes_dir = rtcl::bench::scenes_dir(), scenes = "bunny,dragon,sponza";
   int size = 1024, repeat = 7;
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i];

@@ -3,10 +3,8 @@
 // launches timed by OpenCL events, and the same launches' wall time with
 // the ray upload and the hit read-back), its hits checked against brute
 // force on a subset of rays; written as bench.json and bench.md (formats:
-// bench_report.hpp, README "rtcl bench"). Every input is checked before the
-// first OpenCL call.
-#include <unistd.h>
-
+// bench_report.hpp, docs/cli.md). Every input is checked before the first
+// OpenCL call.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -29,8 +27,11 @@
 #include "commands.hpp"
 #include "distributed.hpp"
 #include "flag_names.hpp"
+#include "option_checks.hpp"
+#include "progress.hpp"
 #include "rtcl/accel.hpp"
 #include "bench/support/ray_sets.hpp"
+#include "bench/support/scenes_dir.hpp"
 #include "rtcl/render/ray_order.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
@@ -44,11 +45,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-std::string default_scenes_dir() {
-  if (const char* dir = std::getenv("RTCL_SCENES_DIR"); dir && *dir) return dir;
-  return "/work/shared/scenes";
 }
 
 // Every registered structure but brute force (O(rays x primitives); it
@@ -94,14 +90,6 @@ std::string utc_now() {
   char text[32];
   std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
   return text;
-}
-
-// One line on stderr, rewritten in place on a terminal.
-void progress(std::size_t done, std::size_t total, const std::string& what) {
-  bool tty = isatty(2);
-  std::fprintf(stderr, "%srtcl bench: [%zu/%zu] %s%s", tty ? "\r\033[K" : "", done, total, what.c_str(),
-               tty ? "" : "\n");
-  std::fflush(stderr);
 }
 
 }  // namespace
@@ -229,7 +217,7 @@ BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) 
     if (a.empty()) throw UsageError("--accel " + options.accel + ": empty structure name in the list");
     parse_accel_flag(a);  // unknown structure or option: "--accel TEXT: ..."
   }
-  std::string scenes_dir = options.scenes_dir.empty() ? default_scenes_dir() : options.scenes_dir;
+  std::string scenes_dir = options.scenes_dir.empty() ? bench::scenes_dir_from_env() : options.scenes_dir;
   for (const std::string& s : split_spec_list(options.scene)) m.scenes.push_back(parse_bench_scene(s, scenes_dir));
   for (const std::string& r : split_spec_list(options.rays)) {
     auto k = std::find(std::begin(kind_names), std::end(kind_names), r);
@@ -237,11 +225,7 @@ BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) 
       throw UsageError("--rays " + options.rays + ": unknown ray set '" + r + "' (known: primary, shadow, diffuse)");
     m.kinds.push_back(static_cast<int>(k - std::begin(kind_names)));
   }
-  try {
-    m.precision = parse_precision_flag(options.precision);
-  } catch (const Error& e) {
-    throw UsageError(e.what());
-  }
+  m.precision = parse_precision_flag(options.precision);
   if (options.diffuse_sort == "measured")
     m.diffuse_sort = ScatteredSort::measured;
   else if (options.diffuse_sort == "always")
@@ -255,7 +239,7 @@ BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) 
   if (create_output) {
     std::error_code error;
     std::filesystem::create_directories(options.output, error);
-    if (error) throw Error("-o " + options.output + ": cannot create the directory: " + error.message());
+    if (error) throw Error("--output " + options.output + ": cannot create the directory: " + error.message());
     check_writable(m.json_path);
     check_writable(m.md_path);
   }
@@ -398,8 +382,8 @@ void run_bench(const BenchOptions& options) {
   std::vector<DeviceInfo> infos = list_devices();
   if (infos.empty()) throw Error("no OpenCL device found (`rtcl devices` lists them)");
   std::vector<Device> devices;
-  if (!options.device.empty()) {
-    devices.push_back(open_device_flag(options.device));
+  if (const char* env = std::getenv("RTCL_DEVICE"); !options.device.empty() || (env && *env)) {
+    devices.push_back(open_device_flag(options.device));  // --device, else $RTCL_DEVICE
   } else {
     for (const DeviceInfo& info : infos) devices.push_back(Device::open(std::to_string(info.index)));
   }
@@ -409,15 +393,19 @@ void run_bench(const BenchOptions& options) {
   }
   if (!options.no_embree) run.embree_version = embree_baseline_version(options.embree_threads);
 
+  Progress progress("rtcl bench", options.quiet);
+  auto step = [&progress](std::size_t done, std::size_t total, const std::string& what) {
+    progress.status("[" + std::to_string(done) + "/" + std::to_string(total) + "] " + what);
+  };
   std::size_t total = matrix.scenes.size() * (devices.size() * matrix.accels.size() + !run.embree_version.empty()),
               done = 0;
   for (const BenchSceneSpec& scene_spec : matrix.scenes) {
-    progress(done, total, scene_spec.text + ": loading, rays and brute-force references");
+    step(done, total, scene_spec.text + ": loading, rays and brute-force references");
     PreparedScene scene = prepare_bench_scene(devices.front(), scene_spec, options);
     run.scene_info.push_back(scene.info);
     std::unique_ptr<EmbreeBaseline> embree;
     if (!run.embree_version.empty()) {
-      progress(done, total, scene_spec.text + " / Embree " + run.embree_version);
+      step(done, total, scene_spec.text + " / Embree " + run.embree_version);
       embree = std::make_unique<EmbreeBaseline>(scene.scene.geometry, options.embree_threads, options.embree_robust,
                                                 build_count(options.repeat));
       for (BenchBaseline& b : bench_embree(*embree, scene, matrix.kinds, options.repeat))
@@ -426,15 +414,14 @@ void run_bench(const BenchOptions& options) {
     }
     for (std::size_t d = 0; d < devices.size(); ++d)
       for (const std::string& accel_name : matrix.accels) {
-        progress(done, total, scene_spec.text + " / " + accel_name + " / " + run.devices[d].name);
+        step(done, total, scene_spec.text + " / " + accel_name + " / " + run.devices[d].name);
         for (BenchCell& cell :
              bench_structure(devices[d], d, scene, accel_name, matrix, options.repeat, embree.get()))
           run.cells.push_back(std::move(cell));
         ++done;
       }
   }
-  progress(done, total, "done");
-  if (isatty(2)) std::fputc('\n', stderr);
+  progress.clear();
   write_bench_results(run, matrix);
 }
 
@@ -447,26 +434,28 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--accel", options->accel,
                   "structures, comma-separated, each with build options as NAME:key=value,... (default: every "
                   "registered structure but brute)");
-  cmd->add_option("--scene", options->scene, "scenes, comma-separated: " + bench_scene_names())
+  cmd->add_option("--scene", options->scene,
+                  "scenes, comma-separated: " + bench_scene_names() +
+                      " (the mesh scenes need --scenes-dir or $RTCL_SCENES_DIR)")
       ->capture_default_str();
   cmd->add_option("--rays", options->rays, "ray sets, comma-separated: primary, shadow, diffuse")
       ->capture_default_str();
-  cmd->add_option("--device", options->device,
-                  "one OpenCL device: index or name substring from `rtcl devices` (default: every device)");
+  add_device_option(*cmd, options->device, "$RTCL_DEVICE, else every device");
   cmd->add_option("--size", options->size, "image side in pixels: size x size primary rays")
-      ->check(CLI::Range(1, 16384))
+      ->check(integer_in(1, 16384))
       ->capture_default_str();
   cmd->add_option("--repeat", options->repeat,
                   "timed launches per cell, after one warm-up launch; builds per structure and scene (at most 9)")
-      ->check(CLI::Range(1, 10000))
+      ->check(integer_in(1, 10000))
       ->capture_default_str();
   cmd->add_option("--check-rays", options->check_rays,
                   "rays per set (every k-th) compared with brute force; 0: none")
-      ->check(CLI::Range(0, 1 << 20))
+      ->check(integer_in(0, 1 << 20))
       ->capture_default_str();
   cmd->add_option("--precision", options->precision,
-                  "every structure's precision level: fast, robust or exact (README \"Precision levels\")")
-      ->capture_default_str();
+                  "every structure's precision level: fast, robust or exact (docs/precision.md)")
+      ->capture_default_str()
+      ->check(one_of(precision_names(), "precision level"));
   cmd->add_flag("--no-embree", options->no_embree,
                "leave out the Embree baseline (present when rtcl was built with Embree)");
   cmd->add_flag("--embree-robust", options->embree_robust,
@@ -474,17 +463,19 @@ void add_bench_command(CLI::App& app) {
                "flags: the baseline for --precision robust or exact like for like");
   cmd->add_option("--diffuse-sort", options->diffuse_sort,
                   "the diffuse rays are traced as scattered calls, which on a CPU device structures with a "
-                  "single-ray kernel may sort first (their cells' times then include the sort; README \"Scattered "
-                  "rays sorted on the device\"): measured (where their calls measured it faster), always or "
-                  "never; Embree traces them as they come")
-      ->capture_default_str();
+                  "single-ray kernel may sort first (their cells' times then include the sort; docs/cli.md): "
+                  "measured (where their calls measured it faster), always or never; Embree traces them as they "
+                  "come")
+      ->capture_default_str()
+      ->check(one_of({"measured", "always", "never"}, "sort policy"));
   cmd->add_option("--embree-threads", options->embree_threads, "host threads Embree traces and builds on")
-      ->check(CLI::Range(1u, 1024u))
+      ->check(integer_in(1, 1024))
       ->capture_default_str();
   cmd->add_option("--scenes-dir", options->scenes_dir,
-                  "directory of the shared meshes (default: $RTCL_SCENES_DIR, else /work/shared/scenes)");
+                  "directory of the shared meshes (default: $RTCL_SCENES_DIR; no other default)");
   cmd->add_option("-o,--output", options->output, "directory for bench.json and bench.md (created if missing)")
       ->capture_default_str();
+  add_quiet_flag(*cmd, options->quiet);
   cmd->callback([options] { run_bench(*options); });
 }
 

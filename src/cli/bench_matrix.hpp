@@ -25,6 +25,7 @@ struct BenchOptions {
   int repeat = 5;
   int check_rays = 256;
   std::string precision = "robust";  // every structure's level (AccelConfig::precision)
+  bool quiet = false;  // no progress display
   bool no_embree = false;  // without Embree built in, there is no baseline either way
   bool embree_robust = false;  // Embree's scenes with RTC_SCENE_FLAG_ROBUST
   // Diffuse rays are traced as Coherence::scattered calls; whether they
@@ -81,7 +82,7 @@ std::vector<BenchBaseline> bench_embree(const EmbreeBaseline& embree, const Prep
 // stdout.
 void write_bench_results(const BenchRun& run, const BenchMatrix& matrix);
 
-// The matrix split over MPI ranks (README "rtcl bench under mpirun").
+// The matrix split over MPI ranks (docs/cli.md, "Under mpirun").
 void bench_distributed(const BenchOptions& options);
 
 }  // namespace rtcl::cli

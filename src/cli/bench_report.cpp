@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "rates.hpp"
+
 namespace rtcl::cli {
 
 Spread spread_of(std::vector<double> values) {
@@ -26,6 +28,12 @@ json spread_json(const Spread& s) { return {{"min", s.min}, {"median", s.median}
 Spread rate_of(std::size_t rays, const Spread& ms) {
   auto rate = [rays](double t) { return t > 0.0 ? static_cast<double>(rays) / (t * 1e3) : 0.0; };
   return {rate(ms.max), rate(ms.median), rate(ms.min)};
+}
+
+// "median (min - max)" of a rate in Mrays/s, each with three significant
+// digits at least (rates.hpp).
+std::string rate_text(const Spread& rate) {
+  return mrays_text(rate.median) + " (" + mrays_text(rate.min) + " - " + mrays_text(rate.max) + ")";
 }
 
 // Embree's traversal rate for a cell: from the traces paired with its
@@ -216,7 +224,7 @@ std::string bench_markdown(const BenchRun& run) {
           }
           if (!first) first = c;
           Spread rate = rate_of(c->ray_count, spread_of(c->kernel_ms));
-          row += format(" %.2f (%.2f - %.2f)", rate.median, rate.min, rate.max);
+          row += " " + rate_text(rate);
           if (c->sorted_runs > 0 && c->sorted_runs == static_cast<int>(c->kernel_ms.size()))
             row += " sorted";
           else if (c->sorted_runs > 0)
@@ -264,7 +272,7 @@ std::string bench_markdown(const BenchRun& run) {
           if (!first) first = b;
           if (api.find(b->api) == std::string::npos) api += (api.empty() ? "" : " / ") + b->api;
           Spread rate = rate_of(b->ray_count, spread_of(b->trace_ms));
-          row += format(" %.2f (%.2f - %.2f) |", rate.median, rate.min, rate.max);
+          row += " " + rate_text(rate) + " |";
           checked += b->checked;
           disagreeing += b->disagreeing;
         }

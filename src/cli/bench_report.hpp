@@ -1,6 +1,6 @@
 // What `rtcl bench` measured, and its two renderings: bench.json (every
 // figure, the machine and the options, so that runs from several machines
-// merge) and bench.md (one table per device). Schema: README, "rtcl bench".
+// merge) and bench.md (one table per device). Schema: docs/cli.md, "rtcl bench".
 #pragma once
 
 #include <chrono>

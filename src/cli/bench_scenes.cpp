@@ -3,6 +3,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "cli_errors.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "rtcl/scene/procedural.hpp"
@@ -62,7 +63,10 @@ BenchSceneSpec parse_bench_scene(const std::string& text, const std::string& sce
   spec.kind = text.substr(0, colon);
   std::string parameters = colon == std::string::npos ? "" : text.substr(colon + 1);
   if (const bench::SceneSpec* shared = bench::find_scene_spec(spec.kind)) {
-    if (!parameters.empty()) throw Error(context + ": the mesh scene " + spec.kind + " takes no parameters");
+    if (!parameters.empty()) throw UsageError(context + ": the mesh scene " + spec.kind + " takes no parameters");
+    if (scenes_dir.empty())
+      throw UsageError(context + ": a mesh scene, and no scenes directory is given: pass --scenes-dir DIR or set "
+                       "RTCL_SCENES_DIR to the directory that holds " + shared->file);
     spec.file = scenes_dir + "/" + shared->file;
     if (!std::filesystem::is_regular_file(spec.file))
       throw Error(context + ": mesh file " + spec.file + " not found (--scenes-dir or $RTCL_SCENES_DIR names the "
@@ -71,12 +75,12 @@ BenchSceneSpec parse_bench_scene(const std::string& text, const std::string& sce
     return spec;
   }
   const Procedural* p = find_procedural(spec.kind);
-  if (!p) throw Error(context + ": unknown scene '" + spec.kind + "' (known: " + bench_scene_names() + ")");
+  if (!p) throw UsageError(context + ": unknown scene '" + spec.kind + "' (known: " + bench_scene_names() + ")");
   spec.size = p->fallback;
   if (!parameters.empty()) {
     std::string key = parameters.substr(0, parameters.find('='));
     if (key != p->parameter || parameters.find('=') == std::string::npos)
-      throw Error(context + ": " + spec.kind + " takes one parameter, " + p->parameter + "=N");
+      throw UsageError(context + ": " + spec.kind + " takes one parameter, " + p->parameter + "=N");
     std::string value = parameters.substr(key.size() + 1);
     std::size_t used = 0;
     long long n = 0;
@@ -86,7 +90,7 @@ BenchSceneSpec parse_bench_scene(const std::string& text, const std::string& sce
       used = 0;
     }
     if (used == 0 || used != value.size() || n < p->lowest || n > p->highest)
-      throw Error(context + ": " + p->parameter + " must be an integer in [" + std::to_string(p->lowest) + ", " +
+      throw UsageError(context + ": " + p->parameter + " must be an integer in [" + std::to_string(p->lowest) + ", " +
                   std::to_string(p->highest) + "], not '" + value + "'");
     spec.size = n;
   }

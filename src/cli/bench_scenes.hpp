@@ -27,8 +27,10 @@ struct BenchSceneSpec {
 // that holds '=' continues the previous entry's parameters.
 std::vector<std::string> split_spec_list(const std::string& text);
 
-// Throws Error "--scene TEXT: PROBLEM" for an unknown scene, parameter or
-// out-of-range size, and names the missing file of a shared scene.
+// Throws UsageError "--scene TEXT: PROBLEM" for an unknown scene, parameter
+// or out-of-range size, and for a shared mesh scene when `scenes_dir` is ""
+// (neither --scenes-dir nor $RTCL_SCENES_DIR given); Error naming the
+// missing file of a shared scene.
 BenchSceneSpec parse_bench_scene(const std::string& text, const std::string& scenes_dir);
 
 // Names --scene accepts, for messages and --help.

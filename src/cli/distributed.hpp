@@ -24,7 +24,7 @@ bool mpi_supported();
 void refuse_ranks_without_mpi(const std::string& command);
 
 // The distributed render: tiles handed out by rank 0, the image written by
-// rank 0 (README "rtcl render under mpirun").
+// rank 0 (docs/cli.md, "Under mpirun").
 void render_distributed(const RenderOptions& o);
 
 }  // namespace rtcl::cli

@@ -1,7 +1,5 @@
 // `rtcl render [scene.json] -o out.png`: Whitted ray tracing on an OpenCL
 // device. Without a scene file it renders the built-in default scene.
-#include <unistd.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -12,8 +10,12 @@
 #include "commands.hpp"
 #include "distributed.hpp"
 #include "flag_names.hpp"
+#include "option_checks.hpp"
+#include "progress.hpp"
+#include "rates.hpp"
 #include "render_options.hpp"
 #include "render_units.hpp"
+#include "scene_lights.hpp"
 #include "rtcl/accel.hpp"
 #include "rtcl/beam/beam_renderer.hpp"
 #include "rtcl/device.hpp"
@@ -32,60 +34,19 @@ namespace rtcl::cli {
 
 namespace {
 
-// A one-line bar on stderr, redrawn only when the shown percentage changes.
-class ProgressBar {
- public:
-  explicit ProgressBar(bool enabled) : enabled_(enabled) {}
-  ~ProgressBar() { finish(); }
-  void update(double fraction) {
-    if (!enabled_) return;
-    int percent = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100.0);
-    if (percent == shown_) return;
-    shown_ = percent;
-    const int width = 40;
-    int filled = percent * width / 100;
-    std::fprintf(stderr, "\rrendering [%s%s] %3d%%", std::string(filled, '#').c_str(),
-                 std::string(width - filled, ' ').c_str(), percent);
-    std::fflush(stderr);
-  }
-  void finish() {
-    if (enabled_ && shown_ >= 0) std::fprintf(stderr, "\r%60s\r", "");
-    shown_ = -1;
-  }
-
- private:
-  bool enabled_;
-  int shown_ = -1;
-};
-
 std::string join(const std::vector<std::string>& items) {
   std::string out;
   for (const auto& i : items) out += (out.empty() ? "-D" : " -D") + i;
   return out;
 }
 
-// A validator of real-valued options: "<value>: must be <what>".
-template <class Accept>
-CLI::Validator real_in(const std::string& what, Accept accept) {
-  return CLI::Validator(
-      [what, accept](std::string& text) {
-        try {
-          if (!accept(std::stod(text))) return text + ": must be " + what;
-        } catch (const std::exception&) {  // not a number: the option's own conversion reports it
-        }
-        return std::string();
-      },
-      what);
-}
-
-double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? rays / (ms * 1e3) : 0.0; }
-
 // --method beam: the scene refused before the device is opened when it has
 // spheres or area lights.
 void run_beam(const RenderOptions& o) {
+  check_image_extension_flag(o.output);
   Scene scene = load_render_scene(o);
   beam::check_beam_scene(scene);
-  check_image_path(o.output);
+  check_image_output_flag(o.output);
   RenderPlan plan = plan_render(o, scene);
   Device device = open_device_flag(o.device);
   beam::BeamSettings bs;
@@ -123,7 +84,16 @@ Image render_sparse(const RenderOptions& o, const RenderPlan& plan, Renderer& re
     WaveletSettings s;
     s.block = o.selective_block;
     s.budget = o.wavelet_budget;
-    image = render_wavelet(renderer, plan.settings, s, &stats);
+    try {
+      image = render_wavelet(renderer, plan.settings, s, &stats);
+    } catch (const Error& e) {
+      // A budget below what the coarse pass of this image traces: the flag's value.
+      const std::string what = e.what(), setting = "wavelet budget ";
+      if (what.rfind(setting, 0) != 0 || what.find(": ") == std::string::npos) throw;
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", static_cast<double>(o.wavelet_budget));
+      throw UsageError("--wavelet-budget " + std::string(value) + what.substr(what.find(": ")));
+    }
   }
   const double pixels = double(plan.settings.width) * plan.settings.height;
   std::printf("rtcl render: %s: traced %llu of %.0f pixels (%.1f%%) in %u batches, %llu rays, %.3f s\n",
@@ -133,12 +103,13 @@ Image render_sparse(const RenderOptions& o, const RenderPlan& plan, Renderer& re
 }
 
 void run(const RenderOptions& o) {
+  check_image_extension_flag(o.output);  // the command line before any file is read
   if (launcher_world_size() && o.method != "ray")
-    throw Error("--method " + o.method + ": not under mpirun (only --method ray renders with ranks)");
+    throw UsageError("--method " + o.method + ": not under mpirun (only --method ray renders with ranks)");
   if (o.method == "beam") {
     if (!o.frames.empty() || !o.spp_sweep.empty())
-      throw Error(std::string(o.frames.empty() ? "--spp-sweep" : "--frames") +
-                  ": not with --method beam (it renders one static image)");
+      throw UsageError(std::string(o.frames.empty() ? "--spp-sweep" : "--frames") +
+                       ": not with --method beam (it renders one static image)");
     if (!o.accel.empty()) parse_accel_flag(o.accel);
     return run_beam(o);
   }
@@ -167,9 +138,9 @@ void run(const RenderOptions& o) {
       write_image(unit.output, render_sparse(o, unit_plan, *renderer));
       continue;
     }
-    ProgressBar bar(!o.quiet && ::isatty(STDERR_FILENO));
-    Image image = renderer->render(unit_plan.settings, [&](double f) { bar.update(f); });
-    bar.finish();
+    Progress progress("rendering", o.quiet);
+    Image image = renderer->render(unit_plan.settings, [&](double f) { progress.bar(f); });
+    progress.clear();
     write_image(unit.output, image);
     RenderOptions unit_options = o;
     unit_options.output = unit.output;
@@ -177,17 +148,28 @@ void run(const RenderOptions& o) {
   }
 }
 
+Scene read_scene_with_lights(const RenderOptions& o, LightNotice* notice) {
+  if (!o.scene.empty() && !o.builtin.empty())
+    throw UsageError("--builtin " + o.builtin + ": give a scene file or a built-in scene, not both (scene file " +
+                     o.scene + ")");
+  Scene scene = o.scene.empty() ? builtin_scene_flag(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
+  *notice = default_lights(scene, o.method != "beam");
+  return scene;
+}
+
 }  // namespace
 
 Scene read_render_scene(const RenderOptions& o) {
-  if (!o.scene.empty() && !o.builtin.empty())
-    throw Error("--builtin " + o.builtin + ": give a scene file or a built-in scene, not both (scene file " + o.scene + ")");
-  return o.scene.empty() ? builtin_scene_flag(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
+  LightNotice ignored;
+  return read_scene_with_lights(o, &ignored);
 }
 
 Scene load_render_scene(const RenderOptions& o) {
-  Scene scene = read_render_scene(o);
+  LightNotice notice;
+  Scene scene = read_scene_with_lights(o, &notice);
   for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
+  if (!notice.note.empty()) std::fprintf(stderr, "rtcl: note: %s\n", notice.note.c_str());
+  if (!notice.warning.empty()) std::fprintf(stderr, "rtcl: warning: %s\n", notice.warning.c_str());
   return scene;
 }
 
@@ -214,15 +196,17 @@ void print_render_summary(const RenderOptions& o, const RenderPlan& plan, const 
                           const RenderStats& st, const std::vector<std::string>& defines) {
   const RenderSettings& settings = plan.settings;
   const RayCounts& r = st.rays;
-  std::printf("rtcl render: %s (%ux%u, %u spp %s seed %u, %s filter, %u light samples, depth %u, %s, %s precision, %s): %llu camera + %llu shadow + %llu reflection + "
-              "%llu refraction = %llu rays in %.3f s, %.2f Mrays/s (trace only: camera %.2f, shadow %.2f, "
-              "secondary %.2f Mrays/s)\n",
+  std::printf("rtcl render: %s (%ux%u, %u spp %s seed %u, %s filter, %u light samples, depth %u, %s, %s precision, "
+              "%s): %llu camera + %llu shadow + %llu reflection + %llu refraction = %llu rays in %.3f s, %s Mrays/s "
+              "(trace only: camera %s, shadow %s, secondary %s Mrays/s)\n",
               o.output.c_str(), settings.width, settings.height, settings.spp, o.sampler.c_str(), settings.seed,
               o.filter.c_str(), settings.light_samples, settings.max_depth, plan.accel.c_str(),
-              std::string(precision_name(plan.config.precision)).c_str(), devices.c_str(), (unsigned long long)r.camera, (unsigned long long)r.shadow,
-              (unsigned long long)r.reflection, (unsigned long long)r.refraction, (unsigned long long)r.total(),
-              st.render_ms * 1e-3, mrays(r.total(), st.render_ms), mrays(r.camera, st.camera_trace_ms),
-              mrays(r.shadow, st.shadow_trace_ms), mrays(r.reflection + r.refraction, st.secondary_trace_ms));
+              std::string(precision_name(plan.config.precision)).c_str(), devices.c_str(),
+              (unsigned long long)r.camera, (unsigned long long)r.shadow, (unsigned long long)r.reflection,
+              (unsigned long long)r.refraction, (unsigned long long)r.total(), st.render_ms * 1e-3,
+              mrays_text(double(r.total()), st.render_ms).c_str(), mrays_text(double(r.camera), st.camera_trace_ms).c_str(),
+              mrays_text(double(r.shadow), st.shadow_trace_ms).c_str(),
+              mrays_text(double(r.reflection + r.refraction), st.secondary_trace_ms).c_str());
   if (o.verbose)
     std::printf("rtcl render: device ms: generate %.1f, trace camera %.1f, shade %.1f, compact %.1f, trace shadow "
                 "%.1f, trace secondary %.1f, accumulate %.1f; %u generations, largest queue %zu rays, queues %.1f "
@@ -238,29 +222,31 @@ void add_render_command(CLI::App& app) {
       "render", "Whitted and distributed ray tracing (reflection, refraction, hard and soft shadows, "
                 "anti-aliasing, depth of field, glossy reflection, motion blur) of a scene file, or of a built-in "
                 "scene when none is given; animations (--frames) and sample sweeps (--spp-sweep)");
-  cmd->add_option("scene", o->scene, "Scene file (JSON, see README); none: a built-in scene (--builtin)");
+  cmd->add_option("scene", o->scene, "Scene file (JSON, docs/file-formats.md); none: a built-in scene (--builtin)");
   cmd->add_option("--builtin", o->builtin,
                   "Built-in scene when no scene file is given: default (Whitted: mirror, glass, hard shadows) | "
                   "showcase (area light, glossy, glass, depth of field, motion blur)")
-      ->check(CLI::IsMember({"default", "showcase"}));
-  cmd->add_option("-o,--output", o->output, "Output image; the extension picks the format (.png: 8-bit sRGB, "
-                                            ".exr: linear float)")
+      ->check(one_of({"default", "showcase"}, "built-in scene"));
+  cmd->add_option("-o,--output", o->output,
+                  "Output image; the extension picks the format: " + image_formats_text() +
+                      "; with --frames or --spp-sweep a pattern with one %d or %04d field")
       ->capture_default_str();
   add_accel_option(*cmd, o->accel);
   cmd->add_option("--precision", o->precision,
                   "fast | robust | exact: the trace kernels' precision level and the spawn offsets (default: the "
-                  "scene file's \"precision\", else robust; see README, Precision levels)");
-  cmd->add_option("--device", o->device, "OpenCL device: index or name substring (see `rtcl devices`)");
-  cmd->add_option("--width", o->width, "Image width in pixels")->capture_default_str()->check(CLI::Range(1, 65536));
+                  "scene file's \"precision\", else robust; docs/precision.md)")
+      ->check(one_of(precision_names(), "precision level"));
+  add_device_option(*cmd, o->device, "$RTCL_DEVICE, else device 0; under mpirun, each rank's own (docs/cli.md)");
+  cmd->add_option("--width", o->width, "Image width in pixels")->capture_default_str()->check(integer_in(1, 65536));
   cmd->add_option("--height", o->height, "Image height in pixels (default: width / the camera's aspect)")
-      ->check(CLI::Range(1, 65536));
+      ->check(integer_in(1, 65536));
   cmd->add_option("--depth", o->depth, "Reflection/refraction bounces after the first hit (speed/accuracy)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 64));
+      ->check(integer_in(0, 64));
   cmd->add_option("--spp", o->spp, "Samples per pixel (anti-aliasing; each carries its own lens, light and glossy "
                                     "samples) (speed/accuracy)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 65536));
+      ->check(integer_in(1, 65536));
   cmd->add_option("--sampler", o->sampler,
                   "Sample pattern: " + sampler_names() +
                       " (stratified: jittered strata, one sample = the pixel centre; random: independent; sobol: "
@@ -268,28 +254,27 @@ void add_render_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::Validator(
           [](const std::string& name) {
-            return sampler_from_name(name) ? std::string()
-                                           : "unknown sampler '" + name + "' (known: " + sampler_names() + ")";
+            return sampler_from_name(name) ? std::string() : "unknown sampler (known: " + sampler_names() + ")";
           },
-          "NAME", "sampler"));
+          "NAME"));
   cmd->add_option("--seed", o->seed, "Seed of every sample pattern (the image is a function of it)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(integer_in(0, 4294967295LL));
   cmd->add_option("--filter", o->filter, "Reconstruction filter: " + filter_names() + " (gaussian: sigma 0.5 px, radius 1.5 px)")
       ->capture_default_str()
       ->check(CLI::Validator(
           [](const std::string& name) {
-            return filter_from_name(name) ? std::string()
-                                          : "unknown filter '" + name + "' (known: " + filter_names() + ")";
+            return filter_from_name(name) ? std::string() : "unknown filter (known: " + filter_names() + ")";
           },
-          "NAME", "filter"));
+          "NAME"));
   cmd->add_option("--light-samples", o->light_samples,
                   "Shadow rays per area light and shading point (soft shadows; speed/accuracy)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 4096));
+      ->check(integer_in(1, 4096));
   cmd->add_option("--min-weight", o->min_weight,
                   "Drop secondary rays whose path weight is below this (speed/accuracy; 0 keeps all)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(number_where("a number in [0, 1]", [](double v) { return v >= 0.0 && v <= 1.0; }));
   cmd->add_option("--method", o->method,
                   "ray: trace every pixel; selective: trace block corners, subdivide blocks whose corners differ, "
                   "interpolate the rest; wavelet: a coarse pass, then whole blocks where its Haar coefficients are "
@@ -297,64 +282,63 @@ void add_render_command(CLI::App& app) {
                   "(polygons, point lights and mirrors only; exact pixel coverage, --spp and the samplers do not "
                   "apply)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"ray", "selective", "wavelet", "beam"}));
+      ->check(one_of({"ray", "selective", "wavelet", "beam"}, "method"));
   cmd->add_option("--selective-block", o->selective_block,
                   "selective, wavelet: side of the first blocks in pixels (1 traces every pixel) (speed/accuracy)")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 256u));
+      ->check(integer_in(1, 256));
+  auto finite_non_negative = [](double v) { return v >= 0.0 && std::isfinite(v); };
   cmd->add_option("--selective-threshold", o->selective_threshold,
                   "selective: a block is interpolated only when its corners' display values (clamped to [0, 1]) "
                   "span less than this per channel, they hit the same material, and their depths agree (0 traces "
                   "every pixel) (speed/accuracy)")
       ->capture_default_str()
-      ->check(real_in("a finite number >= 0", [](double v) { return v >= 0.0 && std::isfinite(v); }));
+      ->check(number_where("a finite number >= 0", finite_non_negative));
   cmd->add_option("--selective-depth", o->selective_depth,
                   "selective: ... and their first-hit distances span at most this fraction of the nearest")
       ->capture_default_str()
-      ->check(real_in("a finite number >= 0", [](double v) { return v >= 0.0 && std::isfinite(v); }));
+      ->check(number_where("a finite number >= 0", finite_non_negative));
   cmd->add_option("--wavelet-budget", o->wavelet_budget,
                   "wavelet: pixels traced in all, coarse pass included, as a fraction of the image's, in (0, 1] "
                   "(speed/accuracy)")
       ->capture_default_str()
-      ->check(real_in("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; }));
+      ->check(number_where("in (0, 1]", [](double v) { return v > 0.0 && v <= 1.0; }));
   cmd->add_option("--frames", o->frames,
                   "Animation: render frames A:B of a scene with moving objects; frame f's shutter is the camera's "
                   "moved by f * --frame-time; the output needs a %d or %04d field for the frame number");
   cmd->add_option("--frame-time", o->frame_time,
-                  "With --frames: keyframe time from one frame to the next (default: the shutter's length)");
+                  "With --frames: keyframe time from one frame to the next (default: the shutter's length)")
+      ->check(number_where("a finite number > 0", [](double v) { return v > 0.0 && std::isfinite(v); }));
   cmd->add_option("--spp-sweep", o->spp_sweep,
                   "One image per samples-per-pixel value, e.g. 1,4,16; the output needs a %d field for the value");
   cmd->add_option("--batch", o->batch, "Camera rays per wavefront (device memory vs parallelism)")
       ->capture_default_str()
-      ->check(CLI::Range(1u, 1u << 26));
+      ->check(integer_in(1, 1 << 26));
   cmd->add_option("--tile", o->tile,
                   "Under mpirun: tile side in pixels, handed out one at a time by rank 0 (a multiple of 8)")
       ->capture_default_str()
-      ->check(CLI::Range(8u, 65536u))
+      ->check(integer_in(8, 65536))
       ->check(CLI::Validator(
           [](std::string& text) {
-            try {
-              if (std::stoul(text) % 8 != 0) return std::string("must be a multiple of 8 (the renderer's 8x8 ray order)");
-            } catch (const std::exception&) {  // not a number: the option's own conversion reports it
-            }
-            return std::string();
+            return std::stoul(text) % 8 == 0 ? std::string()
+                                             : std::string("must be a multiple of 8 (the renderer's 8x8 ray order)");
           },
           "multiple of 8"));
   cmd->add_option("--tile-order", o->tile_order,
                   "Under mpirun: the order tiles are handed out in: rows | shuffled (the image is the same)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"rows", "shuffled"}));
+      ->check(one_of({"rows", "shuffled"}, "tile order"));
   cmd->add_option("--scene-from", o->scene_from,
                   "Under mpirun: root (rank 0 reads the scene and broadcasts it, meshes included) | each (every "
                   "rank reads the file itself, e.g. from a shared file system)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"root", "each"}));
+      ->check(one_of({"root", "each"}, "scene source"));
   cmd->add_option("--beam-order", o->beam_order,
                   "With --method beam: exact (a fragment gives up where a later polygon is nearer) | key (the walk "
                   "in nearest-point order alone; wrong for interpenetrating polygons)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"exact", "key"}));
-  cmd->add_flag("-q,--quiet", o->quiet, "No progress bar");
+      ->check(one_of({"exact", "key"}, "beam order"));
+  add_quiet_flag(*cmd, o->quiet);
   cmd->add_flag("-v,--verbose", o->verbose, "Also print the device time of each stage and the queue sizes");
   cmd->callback([o] { run(*o); });
 }

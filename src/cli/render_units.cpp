@@ -6,6 +6,8 @@
 #include <optional>
 #include <set>
 
+#include "cli_errors.hpp"
+#include "flag_names.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/render/image.hpp"
 #include "rtcl/scene/motion.hpp"
@@ -50,7 +52,7 @@ std::int64_t parse_integer(const std::string& text, const std::string& option, c
     used = 0;
   }
   if (text.empty() || used != text.size() || !(text[0] == '-' || std::isdigit(static_cast<unsigned char>(text[0]))))
-    throw Error(option + " " + whole + ": '" + text + "' is not an integer");
+    throw UsageError(option + " " + whole + ": '" + text + "' is not an integer");
   return v;
 }
 
@@ -68,37 +70,37 @@ std::string expand_output_pattern(const std::string& pattern, std::int64_t value
 RenderUnits plan_units(const RenderOptions& o, const Scene& scene, std::uint32_t spp) {
   RenderUnits out;
   if (!o.frames.empty() && !o.spp_sweep.empty())
-    throw Error("--frames " + o.frames + ": give --frames or --spp-sweep, not both");
-  if (o.frame_time != 0.0 && o.frames.empty()) throw Error("--frame-time: only with --frames");
+    throw UsageError("--frames " + o.frames + ": give --frames or --spp-sweep, not both");
+  if (o.frame_time != 0.0 && o.frames.empty()) throw UsageError("--frame-time: only with --frames");
   int percents = 0;
   std::optional<Field> field = integer_field(o.output, &percents);
   const char* field_help = "one %d or %04d-style field";
   if (!o.frames.empty()) {
     out.kind = UnitKind::frames;
     std::size_t colon = o.frames.find(':');
-    if (colon == std::string::npos) throw Error("--frames " + o.frames + ": expected A:B (first and last frame)");
+    if (colon == std::string::npos) throw UsageError("--frames " + o.frames + ": expected A:B (first and last frame)");
     std::int64_t a = parse_integer(o.frames.substr(0, colon), "--frames", o.frames);
     std::int64_t b = parse_integer(o.frames.substr(colon + 1), "--frames", o.frames);
-    if (a < 0 || b < a) throw Error("--frames " + o.frames + ": needs 0 <= A <= B");
-    if (b - a >= 100000) throw Error("--frames " + o.frames + ": at most 100000 frames");
+    if (a < 0 || b < a) throw UsageError("--frames " + o.frames + ": needs 0 <= A <= B");
+    if (b - a >= 100000) throw UsageError("--frames " + o.frames + ": at most 100000 frames");
+    if (!field)
+      throw UsageError("--output " + o.output + ": with --frames the file name needs " + field_help + " for the frame number");
     if (!scene_moves(scene))
-      throw Error("--frames " + o.frames + ": " + scene.source +
-                  " has no moving object (\"motion\"): every frame would be the same image");
+      throw UsageError("--frames " + o.frames + ": " + scene.source +
+                       " has no moving object (\"motion\"): every frame would be the same image");
     const double open = scene.camera.shutter_open, close = scene.camera.shutter_close;
     out.frame_time = o.frame_time != 0.0 ? o.frame_time : close - open;
     if (!std::isfinite(o.frame_time) || o.frame_time < 0.0)
-      throw Error("--frame-time " + std::to_string(o.frame_time) + ": must be positive");
+      throw UsageError("--frame-time " + std::to_string(o.frame_time) + ": must be positive");
     if (!(out.frame_time > 0.0))
-      throw Error("--frames " + o.frames + ": the camera's shutter is empty (open = close), so frames need --frame-time");
-    if (!field)
-      throw Error("--output " + o.output + ": with --frames the file name needs " + field_help + " for the frame number");
+      throw UsageError("--frames " + o.frames + ": the camera's shutter is empty (open = close), so frames need --frame-time");
     for (std::int64_t f = a; f <= b; ++f) {
       out.units.push_back({expand_output_pattern(o.output, f), f, spp});
       const double shift = static_cast<double>(f) * out.frame_time;
       try {
         check_motion(scene, float(open + shift), float(close + shift));
       } catch (const Error& e) {
-        throw Error("--frames " + o.frames + ": frame " + std::to_string(f) + ": " + e.what());
+        throw UsageError("--frames " + o.frames + ": frame " + std::to_string(f) + ": " + e.what());
       }
     }
   } else if (!o.spp_sweep.empty()) {
@@ -109,22 +111,22 @@ RenderUnits plan_units(const RenderOptions& o, const Scene& scene, std::uint32_t
       std::size_t comma = o.spp_sweep.find(',', start);
       std::string item = o.spp_sweep.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
       std::int64_t v = parse_integer(item, "--spp-sweep", o.spp_sweep);
-      if (v < 1 || v > 65536) throw Error("--spp-sweep " + o.spp_sweep + ": " + item + " is outside 1 .. 65536");
-      if (!seen.insert(v).second) throw Error("--spp-sweep " + o.spp_sweep + ": " + item + " appears twice");
+      if (v < 1 || v > 65536) throw UsageError("--spp-sweep " + o.spp_sweep + ": " + item + " is outside 1 .. 65536");
+      if (!seen.insert(v).second) throw UsageError("--spp-sweep " + o.spp_sweep + ": " + item + " appears twice");
       out.units.push_back({"", 0, static_cast<std::uint32_t>(v)});
       if (comma == std::string::npos) break;
       start = comma + 1;
     }
     if (!field)
-      throw Error("--output " + o.output + ": with --spp-sweep the file name needs " + field_help +
-                  " for the samples per pixel");
+      throw UsageError("--output " + o.output + ": with --spp-sweep the file name needs " + field_help +
+                       " for the samples per pixel");
     for (RenderUnit& u : out.units) u.output = expand_output_pattern(o.output, u.spp);
   } else {
     if (percents > 0 && field)
-      throw Error("--output " + o.output + ": a %d field names several files, but neither --frames nor --spp-sweep is given");
+      throw UsageError("--output " + o.output + ": a %d field names several files, but neither --frames nor --spp-sweep is given");
     out.units.push_back({o.output, 0, spp});
   }
-  for (const RenderUnit& u : out.units) check_image_path(u.output);
+  for (const RenderUnit& u : out.units) check_image_output_flag(u.output);
   return out;
 }
 

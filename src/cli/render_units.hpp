@@ -33,7 +33,7 @@ struct RenderUnits {
 };
 
 // The units of the options for `scene` with `spp` the plan's samples per
-// pixel. Throws Error naming the option for: a malformed or reversed
+// pixel. Throws UsageError naming the option for: a malformed or reversed
 // --frames range (A:B, 0 <= A <= B, at most 100000 frames), a bad
 // --spp-sweep list (integers 1 .. 65536, no repeats), both at once,
 // --frame-time without --frames or not positive, an animation of a scene
@@ -41,7 +41,7 @@ struct RenderUnits {
 // output name without exactly one %d / %0Nd field (N 1..9) while it names
 // several files (or with one while it names one); and a frame whose shutter
 // interval makes some motion singular (naming the frame and the object's
-// motion key). Checks each output path (check_image_path).
+// motion key). Checks each output path (check_image_output_flag).
 RenderUnits plan_units(const RenderOptions& o, const Scene& scene, std::uint32_t spp);
 
 // The scene of a unit: for a frame, the camera's shutter moved to the

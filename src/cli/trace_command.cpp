@@ -13,6 +13,9 @@
 #include "accel_option.hpp"
 #include "commands.hpp"
 #include "flag_names.hpp"
+#include "option_checks.hpp"
+#include "progress.hpp"
+#include "rates.hpp"
 #include "rtcl/accel.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
@@ -30,6 +33,7 @@ struct TraceOptions {
   bool any = false;
   bool coherent = false;
   bool scattered = false;
+  bool quiet = false;
   int repeat = 1;  // timed launches; above 1, after warm-up launches (trace_on_device)
 };
 
@@ -51,7 +55,7 @@ struct TraceResult {
 // bench` warms up);
 // the hits are those of the last.
 TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, std::vector<Hit>& hits, Query query,
-                            Coherence coherence, const std::string& rays_path, int repeat) {
+                            Coherence coherence, const std::string& rays_path, int repeat, Progress& progress) {
   TraceResult result;
   if (rays.empty()) return result;
   const Device& device = accel.device();
@@ -59,11 +63,13 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
   cl::Buffer ray_buffer = device.upload(rays.data(), rays.size() * sizeof(Ray), ray_what.c_str());
   cl::Buffer hit_buffer = device.allocate(hits.size() * sizeof(Hit), hit_what.c_str(), CL_MEM_WRITE_ONLY);
   with_cl_errors([&] {
+    if (repeat > 1) progress.status("warm-up launch");
     if (repeat > 1) accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence).wait();
     for (int w = 0; repeat > 1 && coherence == Coherence::scattered && !accel.sort_choice_settled(query) && w < 16; ++w)
       accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence).wait();
     result.profiled = device.profiling();
     for (int r = 0; r < repeat; ++r) {
+      progress.status(repeat > 1 ? "launch " + std::to_string(r + 1) + " of " + std::to_string(repeat) : "tracing");
       Clock::time_point start = Clock::now();
       cl::Event done = accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence);
       done.wait();
@@ -78,30 +84,32 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
   return result;
 }
 
-// Rays per microsecond; a timer that reads 0 for a tiny launch gives no rate
-// rather than inf.
-double mrays_per_s(std::size_t rays, double ms) { return ms > 0.0 ? static_cast<double>(rays) / (ms * 1e3) : 0.0; }
-
 void run_trace(const TraceOptions& options) {
   std::string accel_name = accel_or_default(options.accel);
   parse_accel_flag(accel_name);  // name and options checked before any work
   AccelConfig config;
   config.precision = parse_precision_flag(options.precision);
   check_writable(options.hits);
+  Progress progress("rtcl trace", options.quiet);
 
+  progress.status("loading " + options.mesh);
   Clock::time_point load_start = Clock::now();
   LoadedMesh mesh = load_mesh(options.mesh);
-  for (const std::string& note : mesh.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   GeometryReport report = validate(mesh.geometry);
   double load_ms = ms_since(load_start);
+  progress.clear();
+  for (const std::string& note : mesh.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   if (report.zero_area_triangles > 0)
     std::fprintf(stderr, "rtcl: note: %s: %zu zero-area triangle%s skipped (no ray can hit them; ids unchanged)\n",
                  options.mesh.c_str(), report.zero_area_triangles, report.zero_area_triangles == 1 ? "" : "s");
+  progress.status("reading " + options.rays);
   std::vector<Ray> rays = read_rays(options.rays);
 
+  progress.status("opening the device");
   Device device = open_device_flag(options.device);
   const DeviceInfo& info = device.info();
   require_precision_flag(info, config.precision);
+  progress.clear();
   std::printf("device: [%zu] %s (%s)\n", info.index, info.name.c_str(), info.platform.c_str());
   std::printf("mesh:   %s: %zu triangles, %zu vertices, %zu objects, loaded in %.1f ms\n", options.mesh.c_str(),
               mesh.geometry.triangles.size(), mesh.geometry.vertices.size(), mesh.objects.size(), load_ms);
@@ -112,8 +120,10 @@ void run_trace(const TraceOptions& options) {
   device.check_fits(rays.size() * sizeof(Ray), "ray buffer for " + options.rays);
   device.check_fits(rays.size() * sizeof(Hit), "hit buffer for " + options.rays);
 
+  progress.status("building " + accel_name);
   Clock::time_point build_start = Clock::now();
   std::unique_ptr<Accel> accel = make_accel(device, accel_name, mesh.geometry, config);
+  progress.clear();
   double setup_ms = ms_since(build_start);
   const AccelStats& stats = accel->stats();
   std::printf(
@@ -126,7 +136,8 @@ void run_trace(const TraceOptions& options) {
                         : options.scattered ? Coherence::scattered
                                             : Coherence::incoherent;
   std::vector<Hit> hits(rays.size());
-  TraceResult traced = trace_on_device(*accel, rays, hits, query, coherence, options.rays, options.repeat);
+  TraceResult traced = trace_on_device(*accel, rays, hits, query, coherence, options.rays, options.repeat, progress);
+  progress.clear();
   const char* kind = options.any ? "any hit (occlusion)" : "closest hit";
   std::size_t per_item = accel->rays_per_work_item(coherence);
   std::string traversal = per_item == 1 ? "one ray per work-item" : std::to_string(per_item) + "-ray packets";
@@ -142,20 +153,22 @@ void run_trace(const TraceOptions& options) {
     std::printf("trace:  %s: no rays\n", kind);
   } else if (traced.trace_ms.size() == 1) {
     double ms = traced.trace_ms[0];
-    std::printf("trace:  %s, %s: %.3f ms (%s), %.2f Mrays/s\n", kind, traversal.c_str(), ms,
-                traced.profiled ? "OpenCL event profiling" : "host clock", mrays_per_s(rays.size(), ms));
+    std::printf("trace:  %s, %s: %.3f ms (%s), %s Mrays/s\n", kind, traversal.c_str(), ms,
+                traced.profiled ? "OpenCL event profiling" : "host clock", mrays_text(double(rays.size()), ms).c_str());
   } else {
     const std::vector<double>& ms = traced.trace_ms;
     double median = ms.size() % 2 ? ms[ms.size() / 2] : 0.5 * (ms[ms.size() / 2 - 1] + ms[ms.size() / 2]);
     std::printf(
-        "trace:  %s, %s: min %.3f / median %.3f / max %.3f ms over %zu warm launches (%s), %.2f / %.2f / %.2f "
+        "trace:  %s, %s: min %.3f / median %.3f / max %.3f ms over %zu warm launches (%s), %s / %s / %s "
         "Mrays/s\n",
         kind, traversal.c_str(), ms.front(), median, ms.back(), ms.size(),
-        traced.profiled ? "OpenCL event profiling" : "host clock", mrays_per_s(rays.size(), ms.back()),
-        mrays_per_s(rays.size(), median), mrays_per_s(rays.size(), ms.front()));
+        traced.profiled ? "OpenCL event profiling" : "host clock", mrays_text(double(rays.size()), ms.back()).c_str(),
+        mrays_text(double(rays.size()), median).c_str(), mrays_text(double(rays.size()), ms.front()).c_str());
   }
   std::size_t hit_count = std::count_if(hits.begin(), hits.end(), [](const Hit& h) { return h.prim >= 0; });
+  progress.status("writing " + options.hits);
   write_hits(options.hits, hits);
+  progress.clear();
   std::printf("hits:   %s: %zu of %zu rays hit\n", options.hits.c_str(), hit_count, hits.size());
 }
 
@@ -174,14 +187,14 @@ void add_trace_command(CLI::App& app) {
   add_accel_option(*cmd, options->accel);
   cmd->add_option("--precision", options->precision,
                   "fast | robust | exact: Moller-Trumbore and fast math / watertight (default) / watertight plus "
-                  "double-precision re-tests (see README, Precision levels)")
-      ->capture_default_str();
-  cmd->add_option("--device", options->device,
-                  "OpenCL device: index or name substring from `rtcl devices` (default: $RTCL_DEVICE, else 0)");
+                  "double-precision re-tests (docs/precision.md)")
+      ->capture_default_str()
+      ->check(one_of(precision_names(), "precision level"));
+  add_device_option(*cmd, options->device, "$RTCL_DEVICE, else device 0");
   cmd->add_option("--repeat", options->repeat,
                   "launch the query N times after one warm-up launch and print the min / median / max kernel time "
                   "(as the benchmarks measure it); the hit file holds the last launch's answers")
-      ->check(CLI::Range(1, 1000000))
+      ->check(integer_in(1, 1000000))
       ->capture_default_str();
   cmd->add_flag("--any", options->any, "occlusion query: report any hit in [tmin, tmax], not the closest");
   cmd->add_flag("--coherent", options->coherent,
@@ -195,9 +208,9 @@ void add_trace_command(CLI::App& app) {
                 "the rays are many unrelated bounces (diffuse or glossy rays from hits in pixel order): on a CPU "
                 "device, structures with a single-ray kernel may sort them on the device by origin cell and "
                 "direction octant first: the first launch sorts, the next does not, later ones take the way "
-                "measured faster, and a sorted launch's time includes the sort (README, Scattered rays sorted on "
-                "the device). The hits are the same")
+                "measured faster, and a sorted launch's time includes the sort (docs/cli.md). The hits are the same")
       ->excludes("--coherent");
+  add_quiet_flag(*cmd, options->quiet);
   cmd->callback([options] { run_trace(*options); });
 }
 

@@ -53,7 +53,12 @@ std::vector<Precision> test_precisions() {
   return levels;
 }
 
-std::string scene_path(const std::string& relative) { return std::string(RTCL_SCENE_DIR) + "/" + relative; }
+std::string scenes_dir() {
+  const char* dir = std::getenv("RTCL_SCENES_DIR");
+  return dir && *dir ? dir : RTCL_SCENE_DIR;
+}
+
+std::string scene_path(const std::string& relative) { return scenes_dir() + "/" + relative; }
 
 Geometry triangle_fan(int count) {
   Geometry g;

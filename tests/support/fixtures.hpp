@@ -29,7 +29,12 @@ std::vector<Precision> test_precisions();
 // traversal meets: "bvh:presplit=1" (a triangle in several leaves).
 std::vector<std::string> tested_structures();
 
-// Absolute path of a file under ../shared/scenes.
+// The directory of the shared meshes: $RTCL_SCENES_DIR, else the
+// ../shared/scenes beside the source tree (RTCL_SCENE_DIR, fixed when the
+// build is configured). Every test finds meshes through it.
+std::string scenes_dir();
+
+// The path of a file under scenes_dir().
 std::string scene_path(const std::string& relative);
 
 // `count` random triangles of size ~`size` inside [0, 1]^3 * scale + offset.

@@ -16,7 +16,7 @@
 // it can take a failed rank's job. The run fails (Error, no result) only
 // when every rank has failed with jobs left. A rank that dies without a
 // word (killed) is not detected here: under Open MPI's mpirun the whole
-// job then ends (README, "rtcl render under mpirun").
+// job then ends (docs/cli.md, "Under mpirun").
 #pragma once
 
 #include <cstddef>

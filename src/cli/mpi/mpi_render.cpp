@@ -327,6 +327,8 @@ void render_distributed(const RenderOptions& o) {
       run(world, o);
     } catch (const StoppedByRoot&) {
       stopped = true;
+    } catch (const UsageError&) {
+      throw;  // a bad command line, found by rank 0: as in one process
     } catch (const std::exception& e) {
       if (world.size == 1) throw;
       throw Error("rank " + std::to_string(world.rank) + " (host " + world.host + "): " + e.what());

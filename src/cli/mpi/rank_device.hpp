@@ -1,6 +1,7 @@
-// The OpenCL device of an MPI rank: --device when given, else device
-// (local rank mod device count) of list_devices(), so that the ranks of one
-// host spread over its devices (two GPUs: two ranks, one each).
+// The OpenCL device of an MPI rank: --device when given, else $RTCL_DEVICE
+// when set (as in every subcommand), else device (local rank mod device
+// count) of list_devices(), so that the ranks of one host spread over its
+// devices (two GPUs: two ranks, one each).
 #pragma once
 
 #include <string>

@@ -2,7 +2,7 @@
 
 #include <charconv>
 #include <cmath>
-#include <sstream>
+#include <cstdio>
 
 #include "rtcl/error.hpp"
 
@@ -10,11 +10,19 @@ namespace rtcl {
 
 namespace {
 
+// x as written: an integer without a fraction ("1000000"), a value that is
+// a float (a default declared as one, such as 1.3f) in the float's shortest
+// form ("1.3", not 1.29999995231628), else the double's shortest form.
 std::string number_text(double x) {
-  std::ostringstream s;
-  s.precision(15);
-  s << x;
-  return s.str();
+  char text[64];
+  if (std::isfinite(x) && x == std::trunc(x) && std::abs(x) < 1e15) {
+    std::snprintf(text, sizeof text, "%.0f", x);
+    return text;
+  }
+  const float f = static_cast<float>(x);
+  auto [end, ec] = static_cast<double>(f) == x ? std::to_chars(text, text + sizeof text, f)
+                                               : std::to_chars(text, text + sizeof text, x);
+  return ec == std::errc() ? std::string(text, end) : std::string("?");
 }
 
 bool parse_double(std::string_view text, double* out) {
