@@ -158,6 +158,19 @@ TEST(Refit, SoupWithSpheresAfterASineDeformationAnswersAsARebuild) {
   expect_refit_answers(built, moved, rays);
 }
 
+// The triangles should stay the build's; when they change (here: the
+// corners of every triangle rotated, and triangles exchanged in pairs), the
+// refit reads them again, and the tree, though worse, answers right.
+TEST(Refit, ChangedTrianglesAreReadAgain) {
+  const Geometry built = random_soup(2000, 13, 0.05f);
+  const Geometry detour = sine_deformed(built, 0.02f, 1.0f);
+  Geometry moved = sine_deformed(built, 0.05f, 1.5f);
+  moved.source = "soup with other triangles";
+  for (glm::uvec3& t : moved.triangles) t = glm::uvec3(t.y, t.z, t.x);
+  for (std::size_t i = 0; i + 1 < moved.triangles.size(); i += 2) std::swap(moved.triangles[i], moved.triangles[i + 1]);
+  expect_refit_answers(built, moved, random_rays(moved, 1500, 14), &detour);
+}
+
 TEST(Refit, TrianglesThatLoseTheirAreaAreMissedAsTheReferenceSkipsThem) {
   Geometry built = random_soup(500, 12, 0.1f);
   Geometry moved = built;

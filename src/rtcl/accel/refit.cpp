@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -173,11 +174,20 @@ void Bvh8Refit::check(const std::string& name, const Geometry& geometry) const {
       throw Error(at + "spheres[" + std::to_string(i) +
                   "] differs from the build's (a refit moves triangles only; build anew to move spheres)");
   }
+  // A pass that the compiler vectorises (a float is NaN or infinite when
+  // its exponent bits are all ones), then the first bad vertex's index.
+  const auto infinite = [](float f) { return (std::bit_cast<std::uint32_t>(f) & 0x7f800000u) == 0x7f800000u; };
   const std::size_t vertices = geometry.vertices.size();
   for_each_part(vertices, part_count(vertices, 0, kCheckPartMin), [&](unsigned, std::size_t begin, std::size_t end) {
+    bool bad = false;
     for (std::size_t i = begin; i < end; ++i) {
       const glm::vec3& v = geometry.vertices[i];
-      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+      bad |= infinite(v.x) | infinite(v.y) | infinite(v.z);
+    }
+    if (!bad) return;
+    for (std::size_t i = begin; i < end; ++i) {
+      const glm::vec3& v = geometry.vertices[i];
+      if (infinite(v.x) || infinite(v.y) || infinite(v.z))
         throw Error(at + "vertices[" + std::to_string(i) + "] is not finite");
     }
   });
