@@ -191,8 +191,9 @@ class Accel {
   // first refit allocates its inputs' buffers, later ones reuse them).
   // `geometry` must have the build's triangle, vertex and sphere counts
   // and its spheres unchanged; the triangles (indices) should be the
-  // build's: they are read again, so that other indices still give right
-  // answers, only a slower tree. Thread-safe: holds the structure's lock
+  // build's: they are compared with the last refit's and read again when
+  // they differ, so that other indices still give right answers, only from
+  // a slower tree. Thread-safe: holds the structure's lock
   // (queries wait; stats() is not synchronised with it).
   // Throws Error, the structure unchanged, when the structure does not
   // support refit (naming it and those that do), for a count or sphere
