@@ -74,6 +74,39 @@ struct AccelStats {
   Aabb bounds;                       // the geometry's box
 };
 
+// When Accel::refit asks for a rebuild (docs/api.md, "Refit").
+struct RefitPolicy {
+  // A refit whose tree's SAH cost exceeds max_cost_ratio times the cost at
+  // the build sets RefitStats::needs_rebuild (refit_or_rebuild then builds
+  // anew). The ratio understates the traces' slowdown: after ten refits of
+  // a growing smooth deformation (bench/refit/refit_bench.cpp), at ratios
+  // of 1.24-1.34, the bunny, the dragon and a 1M-triangle soup traced
+  // 1.1-2.1x slower than on fresh builds; 1.2 rebuilds before that.
+  // >= 1; +inf: never on cost.
+  double max_cost_ratio = 1.2;
+};
+
+// What one Accel::refit (or refit_or_rebuild) did.
+struct RefitStats {
+  double refit_ms = 0.0;    // wall time of the call: checks, upload, device update, read-back
+  // The tree's SAH cost: the expected wide-node visits (weight 0.5) plus
+  // block tests (weight 1) of a ray crossing the root box, each child box
+  // weighted by its area relative to the root's. At the build, and now
+  // (after the refit; the build's when refused or rebuilt).
+  double build_cost = 0.0;
+  double cost = 0.0;
+  double cost_ratio() const { return build_cost > 0.0 ? cost / build_cost : 1.0; }
+  // The refit changed nothing: the structure still answers for the
+  // previous vertices (`reason` says why). Only refit_or_rebuild rebuilds.
+  bool refused = false;
+  // Build the structure anew for these vertices (make_accel): refused, or
+  // cost_ratio() above RefitPolicy::max_cost_ratio (the refit itself is
+  // done and correct; the tree is only slow).
+  bool needs_rebuild = false;
+  bool rebuilt = false;     // refit_or_rebuild built it anew
+  std::string reason;       // why needs_rebuild or rebuilt; empty otherwise
+};
+
 namespace detail {
 struct AccelAccess;
 }
@@ -148,6 +181,30 @@ class Accel {
   cl::Event closest_points(const cl::Buffer& points, const cl::Buffer& out, std::size_t point_count,
                            float max_distance = kUnlimitedDistance, const std::vector<cl::Event>& wait = {}) const;
 
+  // ---- Updates -------------------------------------------------------------
+  // Whether refit is supported: the BVH family ("bvh", "bvh-ploc",
+  // "bvh-packet"); other structures are built anew (refit_or_rebuild).
+  bool supports_refit() const { return refittable(); }
+  // Moves the structure to geometry's vertices, keeping its tree: every
+  // primitive block is filled again from the vertices and every node's
+  // child boxes are recomputed bottom-up on the device, in place (the
+  // first refit allocates its inputs' buffers, later ones reuse them).
+  // `geometry` must have the build's triangle, vertex and sphere counts
+  // and its spheres unchanged; the triangles (indices) should be the
+  // build's: they are compared with the last refit's and read again when
+  // they differ, so that other indices still give right answers, only from
+  // a slower tree. Thread-safe: holds the structure's lock
+  // (queries wait; stats() is not synchronised with it).
+  // Throws Error, the structure unchanged, when the structure does not
+  // support refit (naming it and those that do), for a count or sphere
+  // that differs (naming geometry.vertices, .triangles or .spheres) and
+  // for a NaN/Inf vertex or an out-of-range index (naming it). Returns
+  // refused + needs_rebuild, the structure unchanged, when a triangle
+  // skipped at the build for zero area has an area now (the tree has no
+  // place for it); needs_rebuild alone when the cost passes the policy's
+  // threshold.
+  RefitStats refit(const Geometry& geometry, const RefitPolicy& policy = {});
+
   // ---- Kernels and measurement (benchmarks, tuning) ----------------------
   // Consecutive rays one work-item traces in calls of this coherence: 1
   // (single-ray kernel) or 8 (packet kernel).
@@ -218,6 +275,11 @@ class Accel {
   // (Bvh8Node nodes, TriangleBlock and SphereBlock leaves), which the count,
   // all-hits and closest-point kernels (kernels/query/) walk.
   virtual bool plain_bvh8() const { return false; }
+  // Refit support (Accel::refit): refit_structure runs with the lock held,
+  // after refit checked that refittable(); it sets *bounds to the new
+  // geometry's box when it changes the structure.
+  virtual bool refittable() const { return false; }
+  virtual RefitStats refit_structure(const Geometry& geometry, const RefitPolicy& policy, Aabb* bounds);
 
  private:
   friend struct detail::AccelAccess;
@@ -247,5 +309,14 @@ std::vector<std::string> accel_names();
 // (precision "exact": ...).
 std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, const Geometry& geometry,
                                   const AccelConfig& config = {});
+
+// Brings `accel` (made by make_accel(device, name, ..., config)) to
+// geometry's new vertices: refits it where its structure supports refit,
+// else, or when the refit is refused or passes policy.max_cost_ratio,
+// replaces it with make_accel(accel->device(), name, geometry, config)
+// (RefitStats::rebuilt, `reason` says why). Errors as refit's and
+// make_accel's; on an error `accel` is unchanged.
+RefitStats refit_or_rebuild(std::unique_ptr<Accel>& accel, std::string_view name, const Geometry& geometry,
+                            const AccelConfig& config = {}, const RefitPolicy& policy = {});
 
 }  // namespace rtcl

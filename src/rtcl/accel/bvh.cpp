@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "rtcl/accel/bvh_presplit.hpp"
+#include "rtcl/accel/refit.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/huge_pages.hpp"
 #include "rtcl/parallel.hpp"
@@ -70,7 +71,7 @@ BuildTree build_kind(std::span<const Aabb> bounds, std::span<const std::uint32_t
 class BvhAccel final : public Accel {
  public:
   BvhAccel(const Device& device, std::string name, const BvhConfig& bvh_config, std::vector<std::string> defines,
-           const Bvh8& bvh, AccelStats stats, const AccelConfig& config)
+           const Bvh8& bvh, const Geometry& geometry, AccelStats stats, const AccelConfig& config)
       : Accel(device, std::move(name),
               bvh_config.traversal == BvhTraversal::packet ? packet_kernels(bvh_config, device)
                                                            : single_ray_kernels(bvh_config, device),
@@ -79,7 +80,8 @@ class BvhAccel final : public Accel {
                   : std::optional(packet_kernels(bvh_config, device)),
               std::move(defines), stats, config),
         nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
-        primitives_(upload(device, bvh.blocks)) {}
+        primitives_(upload(device, bvh.blocks)),
+        refit_(bvh, geometry) {}
 
  private:
   static TraceKernels single_ray_kernels(const BvhConfig& config, const Device& device) {
@@ -95,9 +97,14 @@ class BvhAccel final : public Accel {
     kernel.setArg(first + 2, primitives_.spheres);
   }
   bool plain_bvh8() const override { return true; }
+  bool refittable() const override { return true; }
+  RefitStats refit_structure(const Geometry& geometry, const RefitPolicy& policy, Aabb* bounds) override {
+    return refit_.run(*this, nodes_, primitives_.triangles, geometry, policy, bounds);
+  }
 
   cl::Buffer nodes_;
   DevicePrimitives primitives_;
+  Bvh8Refit refit_;
 };
 
 }  // namespace
@@ -210,7 +217,7 @@ std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, 
   Bvh8 bvh = flatten_bvh8(tree, geometry, flatten_options(config));
   AccelStats stats = bvh_stats(geometry, report, bvh, start);
   std::vector<std::string> defines = bvh_defines(geometry, bvh);
-  return std::make_unique<BvhAccel>(device, std::move(name), config, std::move(defines), bvh, stats,
+  return std::make_unique<BvhAccel>(device, std::move(name), config, std::move(defines), bvh, geometry, stats,
                                     accel_config);
 }
 

@@ -91,6 +91,7 @@ struct Bvh8 {
   // ancestor (kernels/accel/bvh.cl).
   std::uint32_t stack_size = 0;
   std::uint32_t depth = 0;       // wide levels on the longest root-to-leaf path
+  std::vector<std::uint32_t> zero_area_triangles;  // ids in no leaf (zero area), ascending
 };
 
 // The box of `node`'s lane `lane` (0..7); an empty slot's is empty (lower

@@ -20,7 +20,7 @@
 //    its binary leaf's box, not a zero-area triangle, not marked before by
 //    the same thread.
 // 3. Marks: no primitive marked by two threads, and every stored primitive
-//    marked.
+//    marked; the unmarked (zero-area) triangles are listed.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -584,6 +584,7 @@ class Flattener {
         if (p >= count) break;
         if (p >= geometry_.triangles.size() || !zero_area(geometry_, p))
           fail("primitive " + std::to_string(p) + " is in no leaf");
+        out_.zero_area_triangles.push_back(static_cast<std::uint32_t>(p));
       }
   }
 
