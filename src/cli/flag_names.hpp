@@ -11,7 +11,7 @@
 #include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/precision.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl::cli {
 
@@ -34,7 +34,7 @@ Device open_device_flag(const std::string& selector);
 
 // builtin_scene(name) under "--builtin NAME": "--builtin x: unknown
 // built-in scene (known: default, showcase)".
-Scene builtin_scene_flag(const std::string& name);
+SceneDescription builtin_scene_flag(const std::string& name);
 
 // When the library raised `e` about the structure `accel` (accel "TEXT",
 // make_accel name "TEXT", Renderer accel "TEXT"): the same problem under

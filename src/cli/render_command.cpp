@@ -83,7 +83,7 @@ double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? rays / (ms * 1e3
 // --method beam: the scene refused before the device is opened when it has
 // spheres or area lights.
 void run_beam(const RenderOptions& o) {
-  Scene scene = load_render_scene(o);
+  SceneDescription scene = load_render_scene(o);
   beam::check_beam_scene(scene);
   check_image_path(o.output);
   RenderPlan plan = plan_render(o, scene);
@@ -147,7 +147,7 @@ void run(const RenderOptions& o) {
     if (mpi_supported()) return render_distributed(o);
   }
   if (!o.accel.empty()) parse_accel_flag(o.accel);  // before the scene is loaded
-  Scene scene = load_render_scene(o);
+  SceneDescription scene = load_render_scene(o);
   RenderPlan plan = plan_render(o, scene);
   RenderUnits units = plan_units(o, scene, plan.settings.spp);  // checks the output paths before the long work
   Device device = open_device_flag(o.device);
@@ -179,19 +179,19 @@ void run(const RenderOptions& o) {
 
 }  // namespace
 
-Scene read_render_scene(const RenderOptions& o) {
+SceneDescription read_render_scene(const RenderOptions& o) {
   if (!o.scene.empty() && !o.builtin.empty())
     throw Error("--builtin " + o.builtin + ": give a scene file or a built-in scene, not both (scene file " + o.scene + ")");
   return o.scene.empty() ? builtin_scene_flag(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
 }
 
-Scene load_render_scene(const RenderOptions& o) {
-  Scene scene = read_render_scene(o);
+SceneDescription load_render_scene(const RenderOptions& o) {
+  SceneDescription scene = read_render_scene(o);
   for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   return scene;
 }
 
-RenderPlan plan_render(const RenderOptions& o, const Scene& scene) {
+RenderPlan plan_render(const RenderOptions& o, const SceneDescription& scene) {
   RenderPlan plan;
   RenderSettings& settings = plan.settings;
   settings.width = o.width;

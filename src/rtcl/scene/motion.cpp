@@ -61,7 +61,7 @@ bool determinant_keeps_sign(const SceneMesh& mesh, double t0, double t1) {
 
 }  // namespace
 
-bool scene_moves(const Scene& scene) {
+bool scene_moves(const SceneDescription& scene) {
   return std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const SceneMesh& m) { return m.end_transform.has_value(); }) ||
          std::any_of(scene.spheres.begin(), scene.spheres.end(), [](const SceneSphere& s) { return s.moving; });
 }
@@ -80,8 +80,8 @@ SceneSphere sphere_at(const SceneSphere& sphere, double time) {
   return s;
 }
 
-Scene scene_at(const Scene& scene, double time) {
-  Scene out = scene;
+SceneDescription scene_at(const SceneDescription& scene, double time) {
+  SceneDescription out = scene;
   for (SceneMesh& m : out.meshes) {
     m.transform = transform_at(m, time);
     m.end_transform.reset();
@@ -90,7 +90,7 @@ Scene scene_at(const Scene& scene, double time) {
   return out;
 }
 
-void check_motion(const Scene& scene, double t0, double t1) {
+void check_motion(const SceneDescription& scene, double t0, double t1) {
   if (!std::isfinite(t0) || !std::isfinite(t1) || t0 > t1)
     throw Error(scene.source + ": camera.shutter: the interval [" + number(t0) + ", " + number(t1) +
                 "] must be finite with open <= close");

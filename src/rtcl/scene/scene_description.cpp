@@ -1,4 +1,4 @@
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 #include <cmath>
 
@@ -10,17 +10,17 @@ namespace {
 
 bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-void check_colour(const Scene& scene, const std::string& where, const glm::vec3& c) {
+void check_colour(const SceneDescription& scene, const std::string& where, const glm::vec3& c) {
   if (!finite(c) || c.x < 0.0f || c.y < 0.0f || c.z < 0.0f)
     throw Error(scene.source + ": " + where + " must be finite and not negative");
 }
 
-void check_unit(const Scene& scene, const std::string& where, const glm::vec3& c) {
+void check_unit(const SceneDescription& scene, const std::string& where, const glm::vec3& c) {
   check_colour(scene, where, c);
   if (c.x > 1.0f || c.y > 1.0f || c.z > 1.0f) throw Error(scene.source + ": " + where + " must lie in [0, 1]");
 }
 
-void validate_camera(const Scene& scene) {
+void validate_camera(const SceneDescription& scene) {
   const Camera& c = scene.camera;
   std::string where = scene.source + ": camera: ";
   if (!finite(c.position) || !finite(c.look_at) || !finite(c.up) || !std::isfinite(c.fov_deg) ||
@@ -38,7 +38,7 @@ void validate_camera(const Scene& scene) {
     throw Error(where + "focus_distance must be positive (got " + std::to_string(c.focus_distance) + ")");
 }
 
-void validate_material(const Scene& scene, std::size_t i) {
+void validate_material(const SceneDescription& scene, std::size_t i) {
   const Material& m = scene.materials[i];
   std::string where = "material '" + m.name + "' ";
   check_colour(scene, where + "ambient", m.ambient);
@@ -55,7 +55,7 @@ void validate_material(const Scene& scene, std::size_t i) {
     throw Error(scene.source + ": " + where + "roughness must lie in [0, 1] (got " + std::to_string(m.roughness) + ")");
 }
 
-void validate_light(const Scene& scene, std::size_t i) {
+void validate_light(const SceneDescription& scene, std::size_t i) {
   const Light& l = scene.lights[i];
   std::string where = scene.source + ": lights[" + std::to_string(i) + "] ";
   if (!finite(l.position)) throw Error(where + "position must be finite");
@@ -84,7 +84,7 @@ double similarity_scale(const glm::dmat4& t, const std::string& what) {
   return s;
 }
 
-void validate(const Scene& scene) {
+void validate(const SceneDescription& scene) {
   validate_camera(scene);
   check_colour(scene, "ambient", scene.ambient);
   check_colour(scene, "background", scene.background);
@@ -107,7 +107,7 @@ void validate(const Scene& scene) {
   if (scene.meshes.empty() && scene.spheres.empty()) throw Error(scene.source + ": the scene has no mesh and no sphere");
 }
 
-FlatScene flatten(const Scene& scene) {
+FlatScene flatten(const SceneDescription& scene) {
   validate(scene);
   FlatScene flat;
   flat.geometry.source = scene.source;
@@ -132,7 +132,7 @@ FlatScene flatten(const Scene& scene) {
   return flat;
 }
 
-std::vector<Light> expand_emissive_lights(const Scene& scene, const FlatScene& flat) {
+std::vector<Light> expand_emissive_lights(const SceneDescription& scene, const FlatScene& flat) {
   std::vector<Light> out;
   const Geometry& g = flat.geometry;
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
@@ -174,9 +174,9 @@ std::vector<Light> expand_emissive_lights(const Scene& scene, const FlatScene& f
   return out;
 }
 
-Scene transform_scene(const Scene& scene, const glm::dmat4& t) {
+SceneDescription transform_scene(const SceneDescription& scene, const glm::dmat4& t) {
   double s = similarity_scale(t, scene.source);
-  Scene out = scene;
+  SceneDescription out = scene;
   out.camera.position = apply_point(t, scene.camera.position);
   out.camera.look_at = apply_point(t, scene.camera.look_at);
   out.camera.up = glm::vec3(glm::dmat3(t) * glm::dvec3(scene.camera.up) / s);
