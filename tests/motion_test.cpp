@@ -304,6 +304,32 @@ TEST(MotionBvh, HitsFollowTheRayTime) {
   }
 }
 
+// Times beyond the shutter are clamped to it and a NaN time is time 0, at
+// every level (the fast level's fast math, which may assume no NaN,
+// included).
+TEST(MotionBvh, TimesAreClampedAndNaNIsTimeZero) {
+  Geometry open, close;
+  open.vertices = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+  open.triangles = {{0, 1, 2}};
+  close = open;
+  for (glm::vec3& v : close.vertices) v.x += 10.0f;
+  const std::vector<Ray> rays = {Ray{0, 0, 5, 0, 0, -1, 0, INFINITY}, Ray{10, 0, 5, 0, 0, -1, 0, INFINITY}};
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (Precision level : test_precisions()) {
+    AccelConfig config;
+    config.precision = level;
+    MotionBvh bvh(test_device(), open, close, MotionBounds::swept, config);
+    for (float time : {nan, -5.0f, -INFINITY}) {
+      std::vector<Hit> hits = run_motion(bvh, rays, {time, time}, Query::closest);
+      EXPECT_TRUE(hits[0].prim == 0 && hits[1].prim == -1) << precision_name(level) << " time " << time;
+    }
+    for (float time : {5.0f, INFINITY}) {
+      std::vector<Hit> hits = run_motion(bvh, rays, {time, time}, Query::closest);
+      EXPECT_TRUE(hits[0].prim == -1 && hits[1].prim == 0) << precision_name(level) << " time " << time;
+    }
+  }
+}
+
 TEST(MotionBvh, TraceWithoutTimesIsAnError) {
   MovingSoup m = moving_soup(1, 1.0f);
   MotionBvh bvh(test_device(), m.open, m.close, MotionBounds::swept);
