@@ -27,6 +27,13 @@ SceneSphere sphere_at(const SceneSphere& sphere, double time);
 // dropped); flatten() of it is the world-space geometry at that time.
 SceneDescription scene_at(const SceneDescription& scene, double time);
 
+// Whether det((1 - t) * open + t * close) keeps the sign of its value at t0,
+// never reaching zero (within rounding of its scale), for t in [t0, t1]:
+// a blend of the two linear maps that never collapses space onto a plane.
+// The cubic's sign at both ends and at its critical points inside decides,
+// since it is monotone between them.
+bool blend_keeps_determinant_sign(const glm::dmat3& open, const glm::dmat3& close, double t0, double t1);
+
 // Throws Error naming the object's motion key when a moving mesh's blended
 // transform is singular (its determinant vanishes or changes sign: the mesh
 // collapses onto a plane) or a moving sphere's radius is not positive at
