@@ -75,6 +75,7 @@ std::vector<Transform> varied_transforms() {
       Transform::translate(3, 3, 0) * Transform::rotate(-70, 0, 1, 1) * Transform::scale(0.25f, 1.5f, -1),
       Transform::translate(0, 0, 3) * Transform::rotate(120, 1, 1, 1) * Transform::scale(1, 1, 3),
       Transform::translate(1e4f, -2e4f, 3e4f) * Transform::rotate(20, 1, 0, 0) * Transform::scale(-1000, 1000, 1000),
+      Transform::translate(-3, 0.5f, 0),
   };
 }
 
@@ -173,6 +174,7 @@ std::vector<Transform> leak_transforms() {
       Transform::translate(1e4f, -2e4f, 3e4f) * Transform::rotate(71, 0.3f, 1, -0.2f) * Transform::scale(1000),
       Transform::translate(-3e3f, 5e2f, 7e3f) * Transform::scale(3, 0.5f, 1.7f) * Transform::rotate(-40, 1, 1, 1),
       Transform::translate(2.5e5f, 1.25e5f, 0) * Transform::rotate(-17, 0, 1, 0),
+      Transform::translate(-7e4f, 3e4f, 1e5f),  // a translation alone: the origin moves, the direction's setup stays
   };
 }
 

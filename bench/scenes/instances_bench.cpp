@@ -14,7 +14,7 @@
 //               threads over rays prepared outside the timed region.
 // rtcl's trace figures are of cl_mem calls until the kernel ends (no upload
 // or read-back). Each figure is the median of --repeat calls after one
-// warm-up call.
+// warm-up call; the identity figures' calls are interleaved.
 //
 //   rtcl_instances_bench [--scenes-dir DIR] [--size 1024] [--repeat 5] [--counts 1000,10000,100000]
 //                        [--forest 10000]
@@ -260,9 +260,20 @@ int main(int argc, char** argv) try {
     two.add_instance(mesh);
     two.add_instance(mesh, rtcl::Transform::translate(far, 0, 0));
     two.commit();
-    const double flat_ms = median_ms(repeat, [&] { flat->trace(rtcl::Query::closest, ray_buffer, hit_buffer, n).wait(); });
-    const double single_ms = median_ms(repeat, [&] { single.trace(rtcl::Query::closest, ray_buffer, hit_buffer, n).wait(); });
-    const double two_ms = median_ms(repeat, [&] { two.trace(rtcl::Query::closest, ray_buffer, hit_buffer, n).wait(); });
+    // The three interleaved, call by call, so that a change in the machine's
+    // load falls on all of them alike.
+    const std::vector<std::function<void()>> calls = {
+        [&] { flat->trace(rtcl::Query::closest, ray_buffer, hit_buffer, n).wait(); },
+        [&] { single.trace(rtcl::Query::closest, ray_buffer, hit_buffer, n).wait(); },
+        [&] { two.trace(rtcl::Query::closest, ray_buffer, hit_buffer, n).wait(); }};
+    std::vector<std::vector<double>> ms(calls.size());
+    for (int r = 0; r <= repeat; ++r)
+      for (std::size_t c = 0; c < calls.size(); ++c) {
+        auto start = Clock::now();
+        calls[c]();
+        if (r > 0) ms[c].push_back(ms_since(start));
+      }
+    const double flat_ms = median(ms[0]), single_ms = median(ms[1]), two_ms = median(ms[2]);
     const double mrays = static_cast<double>(n) * 1e-3;
     std::printf("\n%d x %d bunny primary rays (Mrays/s):\n", size, size);
     std::printf("| flat bvh | one identity instance (single level) | ratio | identity instance, two levels | ratio |\n|---|---|---|---|---|\n");

@@ -28,17 +28,20 @@ double magnitude(const Aabb& b) {
   return std::max({m.x, m.y, m.z});
 }
 
-// The box of `boxes`' corners under x -> a x + t, grown into `out` (double).
+// The box of `boxes`' corners under x -> a x + t, grown into [lower,
+// upper] (double): a box of centre c and half extent e maps to the box of
+// centre a c + t and half extent |a| e (Arvo 1990, "Transforming axis-
+// aligned bounding boxes"), the box of its eight transformed corners.
 void grow_transformed(const std::vector<Aabb>& boxes, const glm::dmat3& a, const glm::dvec3& t, glm::dvec3& lower,
                       glm::dvec3& upper) {
-  for (const Aabb& b : boxes)
-    for (int corner = 0; corner < 8; ++corner) {
-      glm::dvec3 c((corner & 1) ? b.upper.x : b.lower.x, (corner & 2) ? b.upper.y : b.lower.y,
-                   (corner & 4) ? b.upper.z : b.lower.z);
-      glm::dvec3 w = a * c + t;
-      lower = glm::min(lower, w);
-      upper = glm::max(upper, w);
-    }
+  glm::dmat3 magnitude;
+  for (int col = 0; col < 3; ++col) magnitude[col] = glm::abs(a[col]);
+  for (const Aabb& b : boxes) {
+    const glm::dvec3 lo(b.lower), hi(b.upper);
+    const glm::dvec3 centre = a * (0.5 * (lo + hi)) + t, half = magnitude * (0.5 * (hi - lo));
+    lower = glm::min(lower, centre - half);
+    upper = glm::max(upper, centre + half);
+  }
 }
 
 float round_down(double x) {
