@@ -329,8 +329,9 @@ CommitStats Scene::commit() {
         const Instance& in = *st.instances[i];
         placed.push_back({bottom_of.at(in.mesh.value), in.transform, in.at_close, user_id(i)});
       }
-      next->two_level = std::make_shared<const TwoLevel>(st.device, st.config.precision, std::move(bottoms),
-                                                         next->bottom_meshes, placed);
+      next->two_level =
+          std::make_shared<const TwoLevel>(st.device, st.config.precision, std::move(bottoms), next->bottom_meshes,
+                                           placed, previous ? previous->two_level.get() : nullptr);
       stats.top_level_built = true;
     }
     next->stats.device_bytes = next->two_level->device_bytes();

@@ -286,7 +286,8 @@ DeviceBottoms upload_bottoms(const Device& device, std::span<const std::shared_p
 }
 
 TwoLevel::TwoLevel(const Device& device, Precision precision, std::shared_ptr<const DeviceBottoms> bottoms,
-                   std::span<const std::shared_ptr<const MeshBuild>> meshes, std::span<const PlacedInstance> instances)
+                   std::span<const std::shared_ptr<const MeshBuild>> meshes, std::span<const PlacedInstance> instances,
+                   const TwoLevel* previous)
     : device_(device), bottoms_(std::move(bottoms)) {
   // Moving instance i's motion record is the number of moving ones before it.
   std::vector<std::uint32_t> motion_index(instances.size());
@@ -317,25 +318,40 @@ TwoLevel::TwoLevel(const Device& device, Precision precision, std::shared_ptr<co
   top_ = device.upload(top.nodes.data(), top.nodes.size() * sizeof(Bvh8Node), "scene top-level nodes");
   instances_ = device.upload(records.data(), records.size() * sizeof(InstanceRecord), "scene instances");
   motions_ = device.upload(motions.data(), motions.size() * sizeof(InstanceMotion), "scene instance motions");
-  const float zero = 0.0f;
-  no_times_ = device.upload(&zero, sizeof(float), "scene ray times placeholder");
-  no_ids_ = device.allocate(sizeof(cl_uint), "scene instance ids placeholder");
+  if (previous) {  // read only (times) and never written (ids): shared
+    no_times_ = previous->no_times_;
+    no_ids_ = previous->no_ids_;
+  } else {
+    const float zero = 0.0f;
+    no_times_ = device.upload(&zero, sizeof(float), "scene ray times placeholder");
+    no_ids_ = device.allocate(sizeof(cl_uint), "scene instance ids placeholder");
+  }
   require_precision(device.info(), precision);
   defines_ = {"RTCL_STACK_SIZE=" + std::to_string(bvh_kernel_stack_size(bottoms_->stack_size)),
               "RTCL_TOP_STACK_SIZE=" + std::to_string(top_kernel_stack_size(top.stack_size))};
   if (bottoms_->spheres_present) defines_.push_back("RTCL_HAS_SPHERES");
   if (moving_) defines_.push_back("RTCL_INSTANCES_MOVING");
   for (std::string& option : precision_build_options(precision)) defines_.push_back(std::move(option));
+  if (previous && previous->defines_ == defines_) {
+    std::lock_guard lock(previous->mutex_);
+    for (int q = 0; q < 2; ++q) programs_[q] = previous->programs_[q];
+  }
   std::lock_guard lock(mutex_);
-  kernel(Query::closest);  // a kernel that fails to build fails the commit
+  if (!programs_[0])  // a program that fails to build fails the commit
+    programs_[0] = device_.program("accel/instances.cl", with_query(defines_, Query::closest));
+}
+
+std::vector<std::string> TwoLevel::with_query(std::vector<std::string> defines, Query query) {
+  defines.push_back(query == Query::closest ? "RTCL_QUERY_CLOSEST" : "RTCL_QUERY_ANY");
+  return defines;
 }
 
 cl::Kernel& TwoLevel::kernel(Query query) const {
-  std::optional<cl::Kernel>& slot = query == Query::closest ? closest_ : any_;
+  const int q = query == Query::closest ? 0 : 1;
+  std::optional<cl::Kernel>& slot = kernels_[q];
   if (slot) return *slot;
-  std::vector<std::string> defines = defines_;
-  defines.push_back(query == Query::closest ? "RTCL_QUERY_CLOSEST" : "RTCL_QUERY_ANY");
-  cl::Program program = device_.program("accel/instances.cl", defines);
+  if (!programs_[q]) programs_[q] = device_.program("accel/instances.cl", with_query(defines_, query));
+  const cl::Program& program = *programs_[q];
   with_cl_errors([&] {
     cl::Kernel k(program, query == Query::closest ? "trace_closest_instances" : "trace_any_instances");
     cl_uint a = 8;  // after rays, hits, ray_count, instance_ids, write_ids, times, time_stride, time_offset

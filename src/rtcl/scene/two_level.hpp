@@ -88,9 +88,12 @@ TopLevel build_top_level(std::span<const Aabb> world_boxes);
 class TwoLevel {
  public:
   // Uploads the instances (records, motions, top level) over `bottoms`
-  // (shared with other commits over the same meshes).
+  // (shared with other commits over the same meshes) and builds the
+  // closest-hit program, or takes the programs of `previous` (the last
+  // commit's, when it has one) where they were built with the same options.
   TwoLevel(const Device& device, Precision precision, std::shared_ptr<const DeviceBottoms> bottoms,
-           std::span<const std::shared_ptr<const MeshBuild>> meshes, std::span<const PlacedInstance> instances);
+           std::span<const std::shared_ptr<const MeshBuild>> meshes, std::span<const PlacedInstance> instances,
+           const TwoLevel* previous = nullptr);
 
   // The query of rays[0 .. ray_count) into hits (and instance ids, when
   // given); ray i's time is times[i * time_stride + time_offset] when
@@ -105,6 +108,7 @@ class TwoLevel {
 
  private:
   cl::Kernel& kernel(Query query) const;
+  static std::vector<std::string> with_query(std::vector<std::string> defines, Query query);
 
   Device device_;
   std::shared_ptr<const DeviceBottoms> bottoms_;
@@ -113,7 +117,11 @@ class TwoLevel {
   std::size_t bytes_ = 0;
   bool moving_ = false;
   mutable std::mutex mutex_;
-  mutable std::optional<cl::Kernel> closest_, any_;
+  // Per query (closest, any): the program (Device::program assembles and
+  // hashes the source at every call) and its kernel with this commit's
+  // arguments, each made at its first use.
+  mutable std::optional<cl::Program> programs_[2];
+  mutable std::optional<cl::Kernel> kernels_[2];
 };
 
 }  // namespace rtcl
