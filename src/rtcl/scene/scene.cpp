@@ -240,10 +240,16 @@ void Scene::set_instance(InstanceId id, const Instance& instance) {
 }
 
 void Scene::set_transform(InstanceId id, const Transform& transform) {
-  Instance changed = instance(id);
+  State& st = *state_;
+  std::lock_guard lock(st.edit_mutex);
+  Instance& current = st.instance_entry(id, "Scene::set_transform");
+  Instance changed = current;
   changed.transform = transform;
   changed.at_close.reset();
-  set_instance(id, changed);
+  st.check_instance(changed, "Scene::set_transform instance " + std::to_string(id.value) + " (mesh " +
+                                 std::to_string(changed.mesh.value) + ")");
+  current = changed;
+  st.instances_changed = true;
 }
 
 void Scene::remove_instance(InstanceId id) {
