@@ -266,7 +266,7 @@ TEST(Scene, AFailedCommitLeavesTheSceneAsItWas) {
   MeshId big = scene.add_mesh(random_soup(150000, 5));  // about 6 MB of blocks and nodes
   InstanceId extra = scene.add_instance(big, Transform::translate(0, 10, 0));
   std::string e = error_of([&] { scene.commit(); });
-  EXPECT_NE(e.find("bottom levels"), std::string::npos) << e;
+  EXPECT_NE(e.find("Scene::commit: the scene's bottom levels' "), std::string::npos) << e;
   EXPECT_TRUE(same_bits(scene.intersect(rays), before));
   EXPECT_EQ(scene.stats().bottom_levels_built, stats_before.bottom_levels_built);
   EXPECT_EQ(scene.stats().instances, 2u);
@@ -321,6 +321,44 @@ TEST(Scene, BuffersAnswerAsHostArrays) {
   std::vector<std::uint32_t> wrong(3);
   e = error_of([&] { scene.intersect(rays, wrong); });
   EXPECT_NE(e.find("instance_ids holds 3 values"), std::string::npos) << e;
+}
+
+// Host arrays in many batches (the device's buffers lowered to 997 rays),
+// in place and copied, as records and as separate arrays: instance ids
+// and times stay with their rays.
+TEST(Scene, BatchesKeepIdsAndTimesWithTheirRays) {
+  const Geometry g = random_soup(300, 17);  // its blocks fit the lowered buffers
+  const auto fill = [&](Scene& scene) {
+    MeshId mesh = scene.add_mesh(g);
+    scene.add_instance(mesh, Transform::rotate(30, 0, 1, 0));
+    scene.add_instance({mesh, Transform::translate(0, 1.5f, 0), Transform::translate(0.5f, 1.5f, 0), 9u});
+    scene.commit();
+  };
+  std::vector<Ray> rays = random_rays(random_soup(10, 8, 0.05f, 2.5f, glm::vec3(-0.5f)), 5000, 19);
+  std::vector<float> times(rays.size()), origins, directions;
+  for (std::size_t i = 0; i < times.size(); ++i) times[i] = static_cast<float>(i % 7) / 6.0f;
+  for (const Ray& r : rays) {
+    origins.insert(origins.end(), {r.ox, r.oy, r.oz});
+    directions.insert(directions.end(), {r.dx, r.dy, r.dz});
+  }
+  Scene whole(test_device());
+  fill(whole);
+  std::vector<std::uint32_t> expected_ids(rays.size());
+  const std::vector<Hit> expected = whole.intersect(rays, expected_ids, times);
+  ScopedEnv small("RTCL_MAX_ALLOC_BYTES", std::to_string(997 * sizeof(Ray)));
+  Device device = Device::open();
+  Scene batched(device);
+  fill(batched);
+  for (const char* mode : {"", "copy"}) {
+    ScopedEnv host_arrays("RTCL_HOST_ARRAYS", std::string(mode));
+    for (bool records : {true, false}) {
+      std::vector<std::uint32_t> ids(rays.size());
+      std::vector<Hit> hits = records ? batched.intersect(rays, ids, times)
+                                      : batched.intersect(Rays(origins, directions), ids, times);
+      EXPECT_TRUE(same_bits(hits, expected)) << "mode '" << mode << "', records " << records;
+      EXPECT_EQ(ids, expected_ids) << "mode '" << mode << "', records " << records;
+    }
+  }
 }
 
 // Queries during commits see one commit or the other, never a mix: rays

@@ -302,45 +302,51 @@ CommitStats Scene::commit() {
     if (st.instances[i]) live.push_back(static_cast<std::uint32_t>(i));
   const auto user_id = [&](std::uint32_t i) { return st.instances[i]->user_id.value_or(i); };
 
-  if (live.size() == 1 && !st.instances[live[0]]->at_close && is_identity(st.instances[live[0]]->transform)) {
-    const Instance& only = *st.instances[live[0]];
-    next->single_mesh = builds.at(only.mesh.value);
-    next->single_user_id = user_id(live[0]);
-    if (previous && previous->single_mesh == next->single_mesh) {
-      next->single = previous->single;
-    } else {
-      const MeshEntry& entry = st.meshes.at(only.mesh.value);
-      AccelConfig config{st.config.precision, entry.options, st.config.scattered_sort};
-      next->single = make_bvh_accel(st.device, next->single_mesh->built, entry.config, entry.structure, config);
-    }
-    stats.top_level_built = false;
-    next->stats.device_bytes = next->single->stats().device_bytes;
-    next->stats.single_level = true;
-  } else {
-    std::map<std::uint32_t, std::uint32_t> bottom_of;
-    for (const auto& [id, build] : builds) {
-      bottom_of[id] = static_cast<std::uint32_t>(next->bottom_meshes.size());
-      next->bottom_meshes.push_back(build);
-    }
-    const bool same_bottoms = previous && previous->two_level && previous->bottom_meshes == next->bottom_meshes;
-    if (same_bottoms && !st.instances_changed) {
-      next->two_level = previous->two_level;
-    } else {
-      std::shared_ptr<const DeviceBottoms> bottoms =
-          same_bottoms ? previous->two_level->bottoms()
-                       : std::make_shared<const DeviceBottoms>(upload_bottoms(st.device, next->bottom_meshes));
-      std::vector<PlacedInstance> placed;
-      placed.reserve(live.size());
-      for (std::uint32_t i : live) {
-        const Instance& in = *st.instances[i];
-        placed.push_back({bottom_of.at(in.mesh.value), in.transform, in.at_close, user_id(i)});
+  // The structures queries will see; an error names the commit (a mesh's
+  // build error already does).
+  try {
+    if (live.size() == 1 && !st.instances[live[0]]->at_close && is_identity(st.instances[live[0]]->transform)) {
+      const Instance& only = *st.instances[live[0]];
+      next->single_mesh = builds.at(only.mesh.value);
+      next->single_user_id = user_id(live[0]);
+      if (previous && previous->single_mesh == next->single_mesh) {
+        next->single = previous->single;
+      } else {
+        const MeshEntry& entry = st.meshes.at(only.mesh.value);
+        AccelConfig config{st.config.precision, entry.options, st.config.scattered_sort};
+        next->single = make_bvh_accel(st.device, next->single_mesh->built, entry.config, entry.structure, config);
       }
-      next->two_level =
-          std::make_shared<const TwoLevel>(st.device, st.config.precision, std::move(bottoms), next->bottom_meshes,
-                                           placed, previous ? previous->two_level.get() : nullptr);
-      stats.top_level_built = true;
+      stats.top_level_built = false;
+      next->stats.device_bytes = next->single->stats().device_bytes;
+      next->stats.single_level = true;
+    } else {
+      std::map<std::uint32_t, std::uint32_t> bottom_of;
+      for (const auto& [id, build] : builds) {
+        bottom_of[id] = static_cast<std::uint32_t>(next->bottom_meshes.size());
+        next->bottom_meshes.push_back(build);
+      }
+      const bool same_bottoms = previous && previous->two_level && previous->bottom_meshes == next->bottom_meshes;
+      if (same_bottoms && !st.instances_changed) {
+        next->two_level = previous->two_level;
+      } else {
+        std::shared_ptr<const DeviceBottoms> bottoms =
+            same_bottoms ? previous->two_level->bottoms()
+                         : std::make_shared<const DeviceBottoms>(upload_bottoms(st.device, next->bottom_meshes));
+        std::vector<PlacedInstance> placed;
+        placed.reserve(live.size());
+        for (std::uint32_t i : live) {
+          const Instance& in = *st.instances[i];
+          placed.push_back({bottom_of.at(in.mesh.value), in.transform, in.at_close, user_id(i)});
+        }
+        next->two_level =
+            std::make_shared<const TwoLevel>(st.device, st.config.precision, std::move(bottoms), next->bottom_meshes,
+                                             placed, previous ? previous->two_level.get() : nullptr);
+        stats.top_level_built = true;
+      }
+      next->stats.device_bytes = next->two_level->device_bytes();
     }
-    next->stats.device_bytes = next->two_level->device_bytes();
+  } catch (const Error& e) {
+    throw Error("Scene::commit: " + std::string(e.what()));
   }
 
   // Published: nothing below throws.

@@ -276,12 +276,12 @@ DeviceBottoms upload_bottoms(const Device& device, std::span<const std::shared_p
   if (levels.empty()) levels.push_back({});
   out.bytes = levels.size() * sizeof(BottomLevel) + all_nodes.size() * sizeof(Bvh8Node) +
               all_triangles.size() * sizeof(TriangleBlock) + all_spheres.size() * sizeof(SphereBlock);
-  device.check_fits(out.bytes, "the scene's bottom levels");
-  out.levels = device.upload(levels.data(), levels.size() * sizeof(BottomLevel), "scene bottom levels");
-  out.nodes = device.upload(all_nodes.data(), all_nodes.size() * sizeof(Bvh8Node), "scene bottom-level nodes");
+  out.levels = device.upload(levels.data(), levels.size() * sizeof(BottomLevel), "the scene's bottom levels' offsets");
+  out.nodes = device.upload(all_nodes.data(), all_nodes.size() * sizeof(Bvh8Node), "the scene's bottom levels' nodes");
   out.triangles = device.upload(all_triangles.data(), all_triangles.size() * sizeof(TriangleBlock),
-                                "scene triangle blocks");
-  out.spheres = device.upload(all_spheres.data(), all_spheres.size() * sizeof(SphereBlock), "scene sphere blocks");
+                                "the scene's bottom levels' triangle blocks");
+  out.spheres = device.upload(all_spheres.data(), all_spheres.size() * sizeof(SphereBlock),
+                              "the scene's bottom levels' sphere blocks");
   return out;
 }
 
@@ -314,7 +314,6 @@ TwoLevel::TwoLevel(const Device& device, Precision precision, std::shared_ptr<co
   if (motions.empty()) motions.push_back({});
   bytes_ = top.nodes.size() * sizeof(Bvh8Node) + records.size() * sizeof(InstanceRecord) +
            motions.size() * sizeof(InstanceMotion);
-  device.check_fits(bytes_, "the scene's instances and top level");
   top_ = device.upload(top.nodes.data(), top.nodes.size() * sizeof(Bvh8Node), "scene top-level nodes");
   instances_ = device.upload(records.data(), records.size() * sizeof(InstanceRecord), "scene instances");
   motions_ = device.upload(motions.data(), motions.size() * sizeof(InstanceMotion), "scene instance motions");
