@@ -175,7 +175,9 @@ class Scene {
   // instance_ids (empty, or one per ray): the hit instance's user id, else
   // kNoInstance. times (empty, or one per ray): each ray's time for moving
   // instances (fractions of the shutter, clamped to [0, 1], NaN: 0); empty:
-  // time 0. Sizes are checked before anything is written.
+  // time 0. Sizes are checked before anything is written. `coherence` is
+  // Accel's promise, for the single-level path; two levels trace one ray
+  // per work-item whatever it says.
   void trace(Query query, const Rays& rays, std::span<Hit> hits, std::span<std::uint32_t> instance_ids = {},
              std::span<const float> times = {}, Coherence coherence = Coherence::incoherent) const;
   std::vector<Hit> intersect(const Rays& rays, std::span<std::uint32_t> instance_ids = {},
