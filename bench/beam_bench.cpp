@@ -70,7 +70,7 @@ const BeamScene beam_scenes[] = {
 };
 
 struct Fixture {
-  Scene scene;
+  SceneDescription scene;
   std::uint32_t size = 0;
   std::unique_ptr<Renderer> renderer;
   Image reference;

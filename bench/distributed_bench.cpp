@@ -33,9 +33,9 @@ std::uint32_t image_size() {
 }
 
 // scenes/cornell_soft.json, built here from the mesh.
-Scene cornell_soft() {
+SceneDescription cornell_soft() {
   LoadedMesh mesh = load_mesh(scenes_dir() + "/cornell_box/CornellBox-Original.obj");
-  Scene scene;
+  SceneDescription scene;
   scene.source = "cornell_box (soft)";
   scene.camera.position = {0.0f, 1.0f, 3.9f};
   scene.camera.look_at = {0.0f, 1.0f, 0.0f};

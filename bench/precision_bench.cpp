@@ -258,7 +258,7 @@ double self_hit_rate(const Geometry& g, const Accel& accel, const std::vector<Ra
 
 void render_benchmark(benchmark::State& state, const RenderCase& c, Precision level) {
   try {
-    Scene scene = transform_scene(default_scene(), c.transform);
+    SceneDescription scene = transform_scene(default_scene(), c.transform);
     RenderSettings settings;
     settings.width = settings.height = 96;
     static std::map<std::string, test::ReferenceImage> references;

@@ -36,9 +36,9 @@ std::uint32_t render_size() {
 
 // A benchmark scene as the renderer sees it: the mesh with its MTL
 // materials, the spec's camera and light.
-Scene render_scene(const SceneSpec& spec, float kr) {
+SceneDescription render_scene(const SceneSpec& spec, float kr) {
   LoadedMesh mesh = load_mesh(scenes_dir() + "/" + spec.file);
-  Scene scene;
+  SceneDescription scene;
   scene.source = spec.name;
   scene.camera.position = spec.camera.eye;
   scene.camera.look_at = spec.camera.target;
@@ -60,7 +60,7 @@ Scene render_scene(const SceneSpec& spec, float kr) {
 }
 
 // One renderer resident at a time (scene + structure); built outside timing.
-Renderer& renderer_for(const std::string& scene_name, const std::string& accel, const Scene* scene) {
+Renderer& renderer_for(const std::string& scene_name, const std::string& accel, const SceneDescription* scene) {
   static std::string key;
   static std::unique_ptr<Renderer> renderer;
   if (key != scene_name + "/" + accel) {
@@ -76,7 +76,7 @@ double mrays(std::uint64_t rays, double ms) { return ms > 0.0 ? static_cast<doub
 void render_benchmark(benchmark::State& state, const std::string& scene_name, const SceneSpec* spec, float kr,
                       const std::string& accel) {
   try {
-    static std::map<std::string, Scene> scenes;  // small: meshes are flattened by each Renderer
+    static std::map<std::string, SceneDescription> scenes;  // small: meshes are flattened by each Renderer
     if (!scenes.count(scene_name)) {
       scenes.clear();
       scenes.emplace(scene_name, spec ? render_scene(*spec, kr) : default_scene());

@@ -43,9 +43,9 @@ std::uint32_t trade_size() {
   return n >= 16 && n <= 4096 ? static_cast<std::uint32_t>(n) : 128;
 }
 
-Scene trade_scene(const std::string& name) {
+SceneDescription trade_scene(const std::string& name) {
   if (name == "cornell") return load_scene(repo_scene("cornell_soft.json"));
-  Scene scene = load_scene(repo_scene("sibenik.json"));
+  SceneDescription scene = load_scene(repo_scene("sibenik.json"));
   scene.lights.at(0).shape = LightShape::sphere;
   scene.lights.at(0).radius = 1.0f;
   // A ball crossing the nave during the shutter: motion blur.

@@ -7,13 +7,13 @@
 
 #include "fuzz_files.hpp"
 #include "rtcl/error.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 #include "rtcl/scene/scene_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::string path = rtcl::fuzz::write_scratch("input.json", rtcl::fuzz::as_text(data, size));
   try {
-    rtcl::Scene scene = rtcl::load_scene(path);
+    rtcl::SceneDescription scene = rtcl::load_scene(path);
     rtcl::validate(scene);
     rtcl::flatten(scene);
   } catch (const rtcl::Error&) {

@@ -100,7 +100,7 @@ std::vector<World> worlds_of(const beam::ScreenSpace& screen, const Geometry& g,
 }
 
 TEST(BeamCull, KeepsEveryExactCandidateOnTheCornellBox) {
-  Scene scene = load_scene(RTCL_SOURCE_DIR "/scenes/cornell_glass_beam.json");
+  SceneDescription scene = load_scene(RTCL_SOURCE_DIR "/scenes/cornell_glass_beam.json");
   FlatScene flat = flatten(scene);
   const Geometry& g = flat.geometry;
   beam::ScreenSpace screen = beam::screen_space(camera_frame(scene.camera, 64, 64), 64, 64, g);
@@ -142,7 +142,7 @@ TEST(BeamCull, KeepsEveryExactCandidateOfATriangleSoupAtAnyScale) {
 }
 
 TEST(BeamCull, RendererCandidatesEqualThoseOfAllTriangles) {
-  Scene scene = load_scene(RTCL_SOURCE_DIR "/scenes/cornell_glass_beam.json");
+  SceneDescription scene = load_scene(RTCL_SOURCE_DIR "/scenes/cornell_glass_beam.json");
   beam::BeamSettings s;
   s.width = s.height = 32;
   beam::BeamStats with, without;

@@ -24,9 +24,9 @@
 namespace rtcl::test {
 namespace {
 
-Scene cornell_glass() { return load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_glass_beam.json"); }
+SceneDescription cornell_glass() { return load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_glass_beam.json"); }
 
-Material& material(Scene& scene, const std::string& name) {
+Material& material(SceneDescription& scene, const std::string& name) {
   for (Material& m : scene.materials)
     if (m.name == name) return m;
   throw Error("no material " + name);
@@ -44,7 +44,7 @@ struct Comparison {
 // Beam tracing and the ray tracer at 4 spp against the ray tracer at 64 spp
 // (w x w, depth 5), as displayed (clamped to [0, 1]); pixels within one pixel
 // of a step over `step` excused in max_error_unmasked.
-Comparison compare(const Scene& scene, std::uint32_t w, double step) {
+Comparison compare(const SceneDescription& scene, std::uint32_t w, double step) {
   Comparison c;
   beam::BeamSettings bs;
   bs.width = bs.height = w;
@@ -72,7 +72,7 @@ Comparison compare(const Scene& scene, std::uint32_t w, double step) {
 TEST(BeamGlass, IndexOneGlassMatchesTheRayTracer) {
   // eta = 1: alpha = 0, so M_t is the identity, and F = 0: the refracted
   // beams see the scene behind the block exactly, weighted kt.
-  Scene scene = cornell_glass();
+  SceneDescription scene = cornell_glass();
   material(scene, "glass").ior = 1.0f;
   Comparison c = compare(scene, 48, 0.01);
   EXPECT_GT(c.stats.refracted_beams, 0u);
@@ -85,7 +85,7 @@ TEST(BeamGlass, IndexOneGlassMatchesTheRayTracer) {
 }
 
 TEST(BeamGlass, GlassBlockMatchesTheRayTracerAwayFromEdges) {
-  Scene scene = cornell_glass();
+  SceneDescription scene = cornell_glass();
   Comparison c = compare(scene, 48, 0.01);
   EXPECT_GT(c.stats.refracted_beams, 0u);
   EXPECT_GE(c.stats.levels, 3u);  // into the block, out of it, and what lies behind
@@ -106,8 +106,8 @@ TEST(BeamGlass, GlassBlockMatchesTheRayTracerAwayFromEdges) {
 // rays enter at near-normal incidence, meet each leg at about 45 degrees,
 // beyond the critical angle asin(1 / 1.5) = 41.8 degrees, and come back out
 // of the hypotenuse (a retroreflector) to a lit wall behind the camera.
-Scene prism_scene() {
-  Scene scene;
+SceneDescription prism_scene() {
+  SceneDescription scene;
   scene.source = "prism";
   scene.camera.position = {0.0f, 0.0f, 5.0f};
   scene.camera.look_at = {0.0f, 0.0f, 0.0f};
@@ -144,7 +144,7 @@ Scene prism_scene() {
 }
 
 TEST(BeamGlass, TotalInternalReflectionInAPrism) {
-  Scene scene = prism_scene();
+  SceneDescription scene = prism_scene();
   Comparison c = compare(scene, 32, 0.01);
   // Every beam that meets a leg from inside is totally reflected: no
   // refracted beam leaves there, and its whole weight kt goes to the
@@ -163,7 +163,7 @@ TEST(BeamGlass, TotalInternalReflectionInAPrism) {
 // (radiance 1), seen head-on through a 2-degree field of view: every pixel's
 // radiance is a closed form of the weights.
 TEST(BeamGlass, SlabWeightsAreTheFresnelSeries) {
-  Scene scene;
+  SceneDescription scene;
   scene.source = "slab";
   scene.camera.position = {0.0f, 0.0f, 5.0f};
   scene.camera.look_at = {0.0f, 0.0f, 0.0f};
@@ -233,7 +233,7 @@ TEST(BeamGlass, CommandLine) {
 }
 
 TEST(BeamGlass, GlossyMaterialsAreRefused) {
-  Scene scene = cornell_glass();
+  SceneDescription scene = cornell_glass();
   material(scene, "glass").roughness = 0.2f;
   std::string e = error_of([&] { beam::check_beam_scene(scene); });
   EXPECT_NE(e.find("cornell_glass_beam.json: material 'glass' is glossy; --method beam traces mirror reflection and "

@@ -60,7 +60,7 @@ TEST(BeamMirror, ReflectionIsAnInvolutionFixingItsPlane) {
 }
 
 TEST(BeamMirror, MirrorSceneMatchesRayTracerAt64Spp) {
-  Scene scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_mirror_beam.json");
+  SceneDescription scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_mirror_beam.json");
   // The floor a mirror too (the mesh's first two triangles): with the
   // mirror wall it makes a corner reflector, whose beams reach the second
   // and third levels (worlds of two and three M_r).

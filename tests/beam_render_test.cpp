@@ -27,13 +27,13 @@
 namespace rtcl::test {
 namespace {
 
-Scene cornell() { return load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_beam.json"); }
+SceneDescription cornell() { return load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_beam.json"); }
 
 // Exact coverage without beams, tiles or walks: triangle P is visible where
 // its projection lies and no other triangle Q is nearer, i.e. P minus every
 // Q clipped to the half-plane where Q's plane is nearer (polygon2d in
 // double, tested on its own in polygon2d_test.cpp).
-std::map<std::pair<std::uint32_t, std::uint32_t>, double> reference_coverage(const Scene& scene, std::uint32_t w,
+std::map<std::pair<std::uint32_t, std::uint32_t>, double> reference_coverage(const SceneDescription& scene, std::uint32_t w,
                                                                              std::uint32_t h) {
   FlatScene flat = flatten(scene);
   beam::ScreenSpace screen = beam::screen_space(camera_frame(scene.camera, w, h), w, h, flat.geometry);
@@ -59,7 +59,7 @@ std::map<std::pair<std::uint32_t, std::uint32_t>, double> reference_coverage(con
 }
 
 TEST(BeamRender, CoverageMatchesExactReference) {
-  Scene scene = cornell();
+  SceneDescription scene = cornell();
   const std::uint32_t w = 40, h = 40;
   auto want = reference_coverage(scene, w, h);
   beam::BeamSettings s;
@@ -83,7 +83,7 @@ TEST(BeamRender, CoverageMatchesExactReference) {
 }
 
 TEST(BeamRender, DiffuseSceneMatchesRayTracerAt64Spp) {
-  Scene scene = cornell();
+  SceneDescription scene = cornell();
   const std::uint32_t w = 48, h = 48;
   beam::BeamSettings bs;
   bs.width = w;
@@ -116,7 +116,7 @@ TEST(BeamRender, DiffuseSceneMatchesRayTracerAt64Spp) {
 }
 
 TEST(BeamRender, RefusesSpheresAndAreaLights) {
-  Scene scene = cornell();
+  SceneDescription scene = cornell();
   scene.spheres.push_back({});
   try {
     beam::check_beam_scene(scene);
@@ -148,7 +148,7 @@ TEST(BeamRender, CommandLine) {
 }
 
 TEST(BeamRender, MovingObjectsAreRefused) {
-  Scene scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_beam.json");
+  SceneDescription scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell_beam.json");
   ASSERT_FALSE(scene.meshes.empty());
   scene.meshes[0].end_transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.1, 0.0, 0.0));
   scene.meshes[0].motion_key = "moving.json: objects[0].motion";

@@ -44,7 +44,7 @@ RenderSettings settings(std::uint32_t size, std::uint32_t spp, Sampler sampler =
 constexpr double max_unambiguous_error = 1e-3;
 constexpr double max_fraction_over = 0.02;
 
-ImageDifference expect_matches_reference(const Scene& scene, const RenderSettings& s, const std::string& what,
+ImageDifference expect_matches_reference(const SceneDescription& scene, const RenderSettings& s, const std::string& what,
                                          const std::string& accel = "bvh") {
   ReferenceImage ref = reference_render(scene, s);
   Renderer renderer(test_device(), scene, accel);
@@ -60,8 +60,8 @@ ImageDifference expect_matches_reference(const Scene& scene, const RenderSetting
 
 // The default scene with its point light replaced by an area light of the
 // same centre and radiance.
-Scene with_area_light(LightShape shape, float size) {
-  Scene s = default_scene();
+SceneDescription with_area_light(LightShape shape, float size) {
+  SceneDescription s = default_scene();
   Light& l = s.lights.at(0);
   l.shape = shape;
   if (shape == LightShape::quad) {
@@ -73,15 +73,15 @@ Scene with_area_light(LightShape shape, float size) {
   return s;
 }
 
-Scene with_glossy_mirror(float roughness) {
-  Scene s = default_scene();
+SceneDescription with_glossy_mirror(float roughness) {
+  SceneDescription s = default_scene();
   for (Material& m : s.materials)
     if (m.name == "mirror") m.roughness = roughness;
   return s;
 }
 
-Scene with_lens(float aperture, float focus) {
-  Scene s = default_scene();
+SceneDescription with_lens(float aperture, float focus) {
+  SceneDescription s = default_scene();
   s.camera.aperture = aperture;
   s.camera.focus_distance = focus;
   return s;
@@ -105,7 +105,7 @@ TEST(Distributed, EverySamplerAndFilterMatchesTheReference) {
 TEST(Distributed, SoftShadowsOfQuadDiscAndSphereLightsMatchTheReference) {
   for (LightShape shape : {LightShape::quad, LightShape::disc, LightShape::sphere})
     for (Sampler sampler : {Sampler::stratified, Sampler::sobol}) {
-      Scene scene = with_area_light(shape, 0.5f);
+      SceneDescription scene = with_area_light(shape, 0.5f);
       Renderer renderer(test_device(), scene, "brute");
       EXPECT_TRUE(has(renderer.defines(), "RTCL_HAS_AREA_LIGHTS"));
       expect_matches_reference(scene, settings(24, 2, sampler, 3),
@@ -116,7 +116,7 @@ TEST(Distributed, SoftShadowsOfQuadDiscAndSphereLightsMatchTheReference) {
 // The Cornell box lit by its own lamp (MTL Ke): one triangle light per
 // emitting triangle, against the reference.
 TEST(Distributed, EmissiveTrianglesOfTheCornellBoxAreAreaLights) {
-  Scene scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
+  SceneDescription scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
   scene.lights = {Light{}};
   scene.lights[0].shape = LightShape::emissive;
   scene.lights[0].intensity = 0.08f;
@@ -128,7 +128,7 @@ TEST(Distributed, EmissiveTrianglesOfTheCornellBoxAreAreaLights) {
   EXPECT_NEAR(total.x, 17.0f, 1e-4f);
   expect_matches_reference(scene, settings(24, 2, Sampler::sobol, 2), "cornell box, emissive lamp");
 
-  Scene dark = default_scene();
+  SceneDescription dark = default_scene();
   for (Material& m : dark.materials) m.emission = glm::vec3(0.0f);
   dark.lights[0].shape = LightShape::emissive;
   try {
@@ -145,7 +145,7 @@ TEST(Distributed, EmissiveTrianglesOfTheCornellBoxAreAreaLights) {
 // summing n shares of c / n.
 TEST(Distributed, AnAreaLightOfSizeZeroIsThePointLight) {
   RenderSettings s = settings(32, 2, Sampler::random, 4);
-  Scene point = default_scene();
+  SceneDescription point = default_scene();
   ReferenceImage ref = reference_render(point, s);
   Image point_image = Renderer(test_device(), point, "bvh").render(s);
   for (LightShape shape : {LightShape::quad, LightShape::disc, LightShape::sphere}) {
@@ -159,7 +159,7 @@ TEST(Distributed, AnAreaLightOfSizeZeroIsThePointLight) {
 }
 
 TEST(Distributed, ThinLensMatchesTheReference) {
-  Scene scene = with_lens(0.08f, 3.0f);
+  SceneDescription scene = with_lens(0.08f, 3.0f);
   EXPECT_TRUE(has(Renderer(test_device(), scene, "brute").defines(), "RTCL_HAS_SPHERES"));
   for (Sampler sampler : {Sampler::stratified, Sampler::sobol})
     expect_matches_reference(scene, settings(24, 4, sampler), "thin lens, " + std::string(sampler_name(sampler)));
@@ -181,7 +181,7 @@ TEST(Distributed, ZeroApertureIsThePinhole) {
 }
 
 TEST(Distributed, GlossyReflectionMatchesTheReference) {
-  Scene scene = with_glossy_mirror(0.2f);
+  SceneDescription scene = with_glossy_mirror(0.2f);
   EXPECT_TRUE(has(Renderer(test_device(), scene, "brute").defines(), "RTCL_HAS_GLOSSY"));
   for (Sampler sampler : {Sampler::random, Sampler::sobol})
     expect_matches_reference(scene, settings(24, 4, sampler), "glossy mirror, " + std::string(sampler_name(sampler)));
@@ -191,7 +191,7 @@ TEST(Distributed, KernelsCompileOnlyTheEffectsTheSceneHas) {
   Renderer plain(test_device(), default_scene(), "brute");
   EXPECT_FALSE(has(plain.defines(), "RTCL_HAS_AREA_LIGHTS"));
   EXPECT_FALSE(has(plain.defines(), "RTCL_HAS_GLOSSY"));
-  Scene rough_but_diffuse = default_scene();
+  SceneDescription rough_but_diffuse = default_scene();
   for (Material& m : rough_but_diffuse.materials)
     if (!m.reflective() && !m.transmissive()) m.roughness = 0.5f;
   EXPECT_FALSE(has(Renderer(test_device(), rough_but_diffuse, "brute").defines(), "RTCL_HAS_GLOSSY"))
@@ -201,7 +201,7 @@ TEST(Distributed, KernelsCompileOnlyTheEffectsTheSceneHas) {
 // Every effect at once, split into batches that cut tiles and rows: each
 // pixel's samples depend only on (pixel, sample, seed).
 TEST(Distributed, ImagesDoNotDependOnTheBatching) {
-  Scene scene = with_glossy_mirror(0.3f);
+  SceneDescription scene = with_glossy_mirror(0.3f);
   scene.camera.aperture = 0.05f;
   scene.lights[0].shape = LightShape::disc;
   scene.lights[0].radius = 0.2f;
@@ -225,7 +225,7 @@ TEST(Distributed, ImagesDoNotDependOnTheBatching) {
 // under 5% at 64 spp). The low-discrepancy sampler is measured beside it and
 // must have the smaller error at 64 spp.
 TEST(Distributed, IndependentSamplingErrorFallsAsOneOverRootSpp) {
-  Scene scene = with_area_light(LightShape::quad, 0.6f);
+  SceneDescription scene = with_area_light(LightShape::quad, 0.6f);
   const std::uint32_t size = 20, seeds = 8;
   RenderSettings converged = settings(size, 1024, Sampler::sobol, 1);
   converged.seed = 99;
@@ -274,7 +274,7 @@ TEST(Distributed, BadSettingsAreClearErrors) {
   s = settings(8, 1);
   s.filter = static_cast<Filter>(7);
   EXPECT_THROW(renderer.render(s), Error);
-  Scene bad = default_scene();
+  SceneDescription bad = default_scene();
   bad.camera.aperture = -1.0f;
   EXPECT_THROW(Renderer(test_device(), bad, "brute"), Error);
   bad = default_scene();

@@ -43,7 +43,7 @@ std::string scene_text(const std::string& object_motion, const std::string& came
 }
 
 TEST(MotionScene, MotionKeyIsTheEndKeyframeAndShutterIsRead) {
-  Scene s = parse_scene(scene_text(R"(, "transform": {"translate": [1, 0, 0]}, "motion": {"translate": [0, 2, 0], "scale": 2})",
+  SceneDescription s = parse_scene(scene_text(R"(, "transform": {"translate": [1, 0, 0]}, "motion": {"translate": [0, 2, 0], "scale": 2})",
                                    R"(, "shutter": [0.25, 0.75])"),
                         "m.json", ".");
   ASSERT_EQ(s.spheres.size(), 1u);
@@ -78,7 +78,7 @@ TEST(MotionScene, BadMotionIsOneErrorNamingTheKey) {
 // A mesh whose blended transform becomes singular (a half turn flattens it
 // at mid-shutter) is refused naming its motion key; a quarter turn is not.
 TEST(MotionScene, SingularBlendIsAnErrorNamingTheMotionKey) {
-  Scene s = default_scene();
+  SceneDescription s = default_scene();
   SceneMesh& block = s.meshes.at(1);
   block.motion_key = "scene.json: objects[1].motion";
   block.end_transform = glm::rotate(glm::dmat4(1.0), glm::radians(180.0), dvec3(0, 1, 0)) * block.transform;
@@ -96,13 +96,13 @@ TEST(MotionScene, SingularBlendIsAnErrorNamingTheMotionKey) {
 // The broadcast form (rtcl render under mpirun) keeps both keyframes, the
 // shutter and the motion keys.
 TEST(MotionScene, SceneBytesKeepTheKeyframes) {
-  Scene s = parse_scene(scene_text(R"(, "motion": {"translate": [0, 2, 0]})", R"(, "shutter": [0.1, 0.6])"), "m.json", ".");
+  SceneDescription s = parse_scene(scene_text(R"(, "motion": {"translate": [0, 2, 0]})", R"(, "shutter": [0.1, 0.6])"), "m.json", ".");
   s.meshes.push_back(default_scene().meshes.at(1));
   s.meshes.back().end_transform = glm::translate(glm::dmat4(1.0), dvec3(1, 0, 0)) * s.meshes.back().transform;
   s.meshes.back().motion_key = "m.json: objects[1].motion";
   s.materials.push_back(default_scene().materials.at(5));
   s.meshes.back().materials.assign(s.meshes.back().triangles.size(), 1);
-  Scene r = scene_from_bytes(scene_to_bytes(s), "bytes");
+  SceneDescription r = scene_from_bytes(scene_to_bytes(s), "bytes");
   EXPECT_EQ(r.camera.shutter_open, 0.1f);
   EXPECT_EQ(r.camera.shutter_close, 0.6f);
   ASSERT_TRUE(r.spheres.at(0).moving);
@@ -304,6 +304,32 @@ TEST(MotionBvh, HitsFollowTheRayTime) {
   }
 }
 
+// Times beyond the shutter are clamped to it and a NaN time is time 0, at
+// every level (the fast level's fast math, which may assume no NaN,
+// included).
+TEST(MotionBvh, TimesAreClampedAndNaNIsTimeZero) {
+  Geometry open, close;
+  open.vertices = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+  open.triangles = {{0, 1, 2}};
+  close = open;
+  for (glm::vec3& v : close.vertices) v.x += 10.0f;
+  const std::vector<Ray> rays = {Ray{0, 0, 5, 0, 0, -1, 0, INFINITY}, Ray{10, 0, 5, 0, 0, -1, 0, INFINITY}};
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (Precision level : test_precisions()) {
+    AccelConfig config;
+    config.precision = level;
+    MotionBvh bvh(test_device(), open, close, MotionBounds::swept, config);
+    for (float time : {nan, -5.0f, -INFINITY}) {
+      std::vector<Hit> hits = run_motion(bvh, rays, {time, time}, Query::closest);
+      EXPECT_TRUE(hits[0].prim == 0 && hits[1].prim == -1) << precision_name(level) << " time " << time;
+    }
+    for (float time : {5.0f, INFINITY}) {
+      std::vector<Hit> hits = run_motion(bvh, rays, {time, time}, Query::closest);
+      EXPECT_TRUE(hits[0].prim == -1 && hits[1].prim == 0) << precision_name(level) << " time " << time;
+    }
+  }
+}
+
 TEST(MotionBvh, TraceWithoutTimesIsAnError) {
   MovingSoup m = moving_soup(1, 1.0f);
   MotionBvh bvh(test_device(), m.open, m.close, MotionBounds::swept);
@@ -319,8 +345,8 @@ TEST(MotionBvh, TraceWithoutTimesIsAnError) {
 
 // The default scene with the mirror sphere moving right and up, and the
 // glass block sliding and turning (a quarter turn).
-Scene moving_default_scene() {
-  Scene s = default_scene();
+SceneDescription moving_default_scene() {
+  SceneDescription s = default_scene();
   SceneSphere& mirror = s.spheres.at(0);
   mirror.moving = true;
   mirror.end_center = mirror.center + dvec3(0.35, 0.2, 0.0);
@@ -343,7 +369,7 @@ RenderSettings small(std::uint32_t size, std::uint32_t spp, Sampler sampler) {
 // Thresholds of distributed_test.cpp: pixels with a stable ray tree differ
 // by float rounding (1e-3); at most 2% by more than 0.05.
 TEST(MotionRender, MatchesTheReferenceWithTheSameTimes) {
-  Scene scene = moving_default_scene();
+  SceneDescription scene = moving_default_scene();
   scene.camera.shutter_open = 0.2f;
   scene.camera.shutter_close = 0.9f;
   for (MotionBounds bounds : {MotionBounds::swept, MotionBounds::interpolated})
@@ -366,7 +392,7 @@ TEST(MotionRender, MatchesTheReferenceWithTheSameTimes) {
 // Motion blurs: the moving image differs from both keyframes' static images
 // where the objects move, and lies between them on average.
 TEST(MotionRender, BlurDiffersFromEitherKeyframe) {
-  Scene scene = moving_default_scene();
+  SceneDescription scene = moving_default_scene();
   RenderSettings s = small(32, 8, Sampler::stratified);
   Image blurred = Renderer(test_device(), scene, "bvh").render(s);
   Image at_open = Renderer(test_device(), scene_at(scene, 0.0), "bvh").render(s);
@@ -378,8 +404,8 @@ TEST(MotionRender, BlurDiffersFromEitherKeyframe) {
 // Zero motion (end keyframes equal to the start) takes the moving path
 // (motion BVH, time code) and gives the static scene's image.
 TEST(MotionRender, ZeroMotionEqualsTheStaticScene) {
-  Scene still = default_scene();
-  Scene zero = still;
+  SceneDescription still = default_scene();
+  SceneDescription zero = still;
   zero.meshes.at(1).end_transform = zero.meshes.at(1).transform;
   zero.spheres.at(0).moving = true;
   zero.spheres.at(0).end_center = zero.spheres.at(0).center;
@@ -395,9 +421,9 @@ TEST(MotionRender, ZeroMotionEqualsTheStaticScene) {
 }
 
 TEST(MotionRender, MovingSceneNeedsTheBvhAndStaticLamps) {
-  Scene scene = moving_default_scene();
+  SceneDescription scene = moving_default_scene();
   EXPECT_NE(error_of([&] { Renderer(test_device(), scene, "grid"); }).find("Renderer accel \"grid\": "), std::string::npos);
-  Scene lamp = scene;
+  SceneDescription lamp = scene;
   lamp.lights = {Light{}};
   lamp.lights[0].shape = LightShape::emissive;
   lamp.meshes.at(0).end_transform = glm::translate(glm::dmat4(1.0), dvec3(0, 0.1, 0));

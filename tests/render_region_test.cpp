@@ -24,7 +24,7 @@ Image tiled(Renderer& renderer, const RenderSettings& s, std::uint32_t tile, Til
 TEST(RenderRegion, TilesInAnyOrderAndSizeGiveTheWholeImage) {
   struct Case {
     const char* what;
-    Scene scene;
+    SceneDescription scene;
     Sampler sampler;
   };
   const std::string scenes = RTCL_SOURCE_DIR "/scenes/";

@@ -52,7 +52,7 @@ constexpr double max_unambiguous_error = 1e-3;
 constexpr double max_fraction_over = 0.02;
 constexpr double max_rmse = 0.05;
 
-void expect_matches_reference(const Scene& scene, const RenderSettings& settings, const std::string& what) {
+void expect_matches_reference(const SceneDescription& scene, const RenderSettings& settings, const std::string& what) {
   ReferenceImage ref = reference_render(scene, settings);
   for (const std::string& accel : accel_names()) {
     Renderer renderer(test_device(), scene, accel);
@@ -74,13 +74,13 @@ TEST(Render, DefaultSceneMatchesReferenceForEveryAccel) {
 }
 
 TEST(Render, CornellSceneFileMatchesReferenceForEveryAccel) {
-  Scene scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
+  SceneDescription scene = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
   expect_matches_reference(scene, small(48), "scenes/cornell.json");
 }
 
 TEST(Render, JitteredSamplesMatchReference) {
   RenderSettings s = small(24, 4);
-  Scene scene = default_scene();
+  SceneDescription scene = default_scene();
   ReferenceImage ref = reference_render(scene, s);
   Renderer renderer(test_device(), scene, "bvh");
   ImageDifference d = compare_images(renderer.render(s), ref.image, ref.ambiguous);
@@ -107,8 +107,8 @@ SceneMesh box_mesh(glm::vec3 lo, glm::vec3 hi, std::uint32_t material) {
 }
 
 // A glass slab 1 unit thick (z in [-0.5, 0.5]), 40 units wide.
-Scene glass_slab(float ior = 1.5f) {
-  Scene s;
+SceneDescription glass_slab(float ior = 1.5f) {
+  SceneDescription s;
   s.source = "glass slab";
   s.camera.position = {0, 0, 5};
   Material glass;
@@ -217,9 +217,9 @@ struct ScaleCase {
   double max_smooth_error;
 };
 
-void expect_scaled_scene_matches_reference(const Scene& base, const ScaleCase& c, Precision level) {
+void expect_scaled_scene_matches_reference(const SceneDescription& base, const ScaleCase& c, Precision level) {
   RenderSettings settings = small(64);
-  Scene scene = transform_scene(base, c.transform);
+  SceneDescription scene = transform_scene(base, c.transform);
   ReferenceImage ref = reference_render(scene, settings);
   std::vector<std::uint8_t> excused = edge_pixels(ref.image, 0.05, c.edge_radius);
   for (std::size_t i = 0; i < excused.size(); ++i) excused[i] |= ref.ambiguous[i];
@@ -237,9 +237,9 @@ void expect_scaled_scene_matches_reference(const Scene& base, const ScaleCase& c
 
 // The fast level's fixed spawn offset, measured (not asserted: acne and
 // light leaks at the extremes are that level's documented trade).
-void report_fast_level(const Scene& base, const ScaleCase& c) {
+void report_fast_level(const SceneDescription& base, const ScaleCase& c) {
   RenderSettings settings = small(64);
-  Scene scene = transform_scene(base, c.transform);
+  SceneDescription scene = transform_scene(base, c.transform);
   ReferenceImage ref = reference_render(scene, settings);
   std::vector<std::uint8_t> excused = edge_pixels(ref.image, 0.05, c.edge_radius);
   for (std::size_t i = 0; i < excused.size(); ++i) excused[i] |= ref.ambiguous[i];
@@ -265,7 +265,7 @@ TEST(Render, ScaledAndTranslatedDefaultSceneMatchesTheReferenceAtThatScale) {
 }
 
 TEST(Render, NoShadowAcneAtGrazingAnglesAtAnyScale) {
-  Scene base;
+  SceneDescription base;
   base.source = "grazing floor";
   base.camera.position = {0.0f, 0.5f, 6.0f};
   base.camera.look_at = {0.0f, -0.35f, 0.0f};
@@ -289,7 +289,7 @@ TEST(Render, NoShadowAcneAtGrazingAnglesAtAnyScale) {
 // --- determinism, knobs, specialisation -----------------------------------------
 
 TEST(Render, DeterministicAndIndependentOfBatchSize) {
-  Scene scene = default_scene();
+  SceneDescription scene = default_scene();
   Renderer renderer(test_device(), scene, "bvh");
   RenderSettings s = small(40, 2);
   Image a = renderer.render(s);
@@ -301,7 +301,7 @@ TEST(Render, DeterministicAndIndependentOfBatchSize) {
 }
 
 TEST(Render, DepthAndWeightThresholdTradeRaysForAccuracy) {
-  Scene scene = default_scene();
+  SceneDescription scene = default_scene();
   Renderer renderer(test_device(), scene, "bvh");
   RenderSettings s = small(48);
   s.min_weight = 0.0f;
@@ -337,7 +337,7 @@ TEST(Render, KernelsAreSpecialisedToTheScene) {
   EXPECT_TRUE(has(full.defines(), "RTCL_LIGHT_COUNT=1"));
 
   // Only opaque diffuse triangles: no sphere, reflection or refraction code.
-  Scene plain = default_scene();
+  SceneDescription plain = default_scene();
   plain.spheres.clear();
   plain.meshes.resize(1);  // the room, no glass block
   for (Material& m : plain.materials) m.kr = m.kt = glm::vec3(0.0f);

@@ -12,7 +12,7 @@
 namespace rtcl::test {
 namespace {
 
-void expect_same(const Scene& a, const Scene& b) {
+void expect_same(const SceneDescription& a, const SceneDescription& b) {
   EXPECT_EQ(a.source, b.source);
   EXPECT_EQ(0, std::memcmp(&a.camera, &b.camera, sizeof a.camera));
   EXPECT_EQ(a.ambient, b.ambient);
@@ -52,12 +52,12 @@ void expect_same(const Scene& a, const Scene& b) {
 }
 
 TEST(SceneBytes, RoundTripKeepsEveryField) {
-  Scene scene = default_scene();
+  SceneDescription scene = default_scene();
   scene.notes = {"a note"};
   scene.precision = Precision::exact;
   scene.accel = "grid:lambda=4";
   expect_same(scene, scene_from_bytes(scene_to_bytes(scene), "test"));
-  Scene file = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
+  SceneDescription file = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
   expect_same(file, scene_from_bytes(scene_to_bytes(file), "test"));
 }
 

@@ -51,7 +51,7 @@ const std::string glass = "\"glass\": {\"diffuse\": 0, \"kt\": 1, \"ior\": 1.5}"
 const std::string sphere = "{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"glass\"}";
 
 TEST(SceneFile, ShippedScenesLoad) {
-  Scene cornell = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
+  SceneDescription cornell = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
   ASSERT_EQ(cornell.meshes.size(), 1u);
   EXPECT_EQ(cornell.meshes[0].triangles.size(), 36u);
   ASSERT_EQ(cornell.spheres.size(), 2u);
@@ -83,7 +83,7 @@ TEST(SceneFile, TransformsMaterialsAndRelativePaths) {
                      sphere,
                  "  // comments are allowed\n  \"ambient\": [0.1, 0.2, 0.3], \"background\": 0.5,\n"
                  "  \"lights\": [{\"position\": [0, 4, 0], \"color\": 0.5, \"intensity\": 2}],\n"));
-  Scene scene = load_scene(path);
+  SceneDescription scene = load_scene(path);
   EXPECT_EQ(scene.ambient, glm::vec3(0.1f, 0.2f, 0.3f));
   EXPECT_EQ(scene.background, glm::vec3(0.5f));
   ASSERT_EQ(scene.lights.size(), 1u);
@@ -118,7 +118,7 @@ TEST(SceneFile, AreaLightsLensAndRoughness) {
       "             {\"position\": [0, 3, 0]}, {\"type\": \"emissive\", \"intensity\": 0.1}],\n"
       "  \"materials\": {\"satin\": {\"kr\": 0.5, \"roughness\": 0.3}},\n"
       "  \"objects\": [{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radius\": 1, \"material\": \"satin\"}]\n}\n";
-  Scene scene = load_scene(f.dir.write("scene.json", text));
+  SceneDescription scene = load_scene(f.dir.write("scene.json", text));
   EXPECT_EQ(scene.camera.aperture, 0.1f);
   EXPECT_EQ(scene.camera.focus_distance, 4.0f);
   ASSERT_EQ(scene.lights.size(), 5u);
@@ -143,7 +143,7 @@ TEST(SceneFile, PlyAndStlMeshes) {
   f.dir.write("tri.ply",
               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
               "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-  Scene scene = load_scene(f.dir.write(
+  SceneDescription scene = load_scene(f.dir.write(
       "scene.json", scene_text(glass, "{\"type\": \"mesh\", \"file\": \"tri.stl\", \"material\": \"glass\"},"
                                       "{\"type\": \"mesh\", \"file\": \"tri.ply\", "
                                       "\"transform\": {\"translate\": [0, 0, 2]}}")));
@@ -155,10 +155,10 @@ TEST(SceneFile, PlyAndStlMeshes) {
 
 TEST(SceneFile, MirroringTransformKeepsFacesOutward) {
   Files f;
-  Scene plain = load_scene(f.dir.write("a.json", scene_text(glass, "{\"type\": \"mesh\", \"file\": \"tri.obj\"}")));
-  Scene mirrored = load_scene(f.dir.write(
+  SceneDescription plain = load_scene(f.dir.write("a.json", scene_text(glass, "{\"type\": \"mesh\", \"file\": \"tri.obj\"}")));
+  SceneDescription mirrored = load_scene(f.dir.write(
       "b.json", scene_text(glass, "{\"type\": \"mesh\", \"file\": \"tri.obj\", \"transform\": {\"scale\": [1, 1, -1]}}")));
-  auto normal_z = [](const Scene& s) {
+  auto normal_z = [](const SceneDescription& s) {
     FlatScene flat = flatten(s);
     const auto& g = flat.geometry;
     glm::vec3 a = g.vertices[g.triangles[0][0]], b = g.vertices[g.triangles[0][1]], c = g.vertices[g.triangles[0][2]];
@@ -249,7 +249,7 @@ TEST(SceneFile, BadFilesGiveClearErrors) {
 }
 
 TEST(Scene, DefaultSceneShowsEveryEffect) {
-  Scene s = default_scene();
+  SceneDescription s = default_scene();
   validate(s);
   bool mirror = false, glass_sphere = false, glass_mesh = false, emissive = false;
   FlatScene flat = flatten(s);
@@ -266,7 +266,7 @@ TEST(Scene, DefaultSceneShowsEveryEffect) {
 }
 
 TEST(Scene, InvalidScenesAreRejected) {
-  Scene s = default_scene();
+  SceneDescription s = default_scene();
   s.materials[0].ior = -1.0f;
   EXPECT_THROW(validate(s), Error);
   s = default_scene();

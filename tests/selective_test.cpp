@@ -94,8 +94,8 @@ RenderSettings small_settings() {
 }
 
 // Every distributed decision at once, so that every sample key is exercised.
-Scene busy_scene() {
-  Scene scene = default_scene();
+SceneDescription busy_scene() {
+  SceneDescription scene = default_scene();
   scene.camera.aperture = 0.05f;
   scene.lights.at(0).shape = LightShape::disc;
   scene.lights.at(0).radius = 0.2f;

@@ -26,7 +26,7 @@ bool has(const std::vector<std::string>& defines, const std::string& d) {
 }
 
 TEST(Showcase, HasEveryEffect) {
-  Scene s = showcase_scene();
+  SceneDescription s = showcase_scene();
   EXPECT_TRUE(std::any_of(s.lights.begin(), s.lights.end(), [](const Light& l) { return l.area(); }));
   EXPECT_TRUE(std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.glossy(); }));
   EXPECT_TRUE(std::any_of(s.materials.begin(), s.materials.end(), [](const Material& m) { return m.transmissive(); }));
@@ -41,7 +41,7 @@ TEST(Showcase, HasEveryEffect) {
 // The thresholds of distributed_test.cpp (float rounding 1e-3 where the ray
 // tree is stable; at most 2% of the pixels over 0.05).
 TEST(Showcase, MatchesTheReferenceAtTinySize) {
-  Scene scene = showcase_scene();
+  SceneDescription scene = showcase_scene();
   RenderSettings s;
   s.width = s.height = 20;
   s.spp = 4;

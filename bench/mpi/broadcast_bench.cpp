@@ -24,9 +24,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
-rtcl::Scene soup_scene(std::size_t triangles) {
+rtcl::SceneDescription soup_scene(std::size_t triangles) {
   rtcl::Geometry g = rtcl::random_triangle_soup(triangles);
-  rtcl::Scene scene = rtcl::default_scene();
+  rtcl::SceneDescription scene = rtcl::default_scene();
   scene.meshes.clear();
   scene.spheres.clear();
   rtcl::SceneMesh mesh;
@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
         std::vector<std::byte> bytes;
         double encode_ms = 0.0;
         if (world.rank == 0) {
-          rtcl::Scene scene = soup_scene(n);
+          rtcl::SceneDescription scene = soup_scene(n);
           Clock::time_point t = Clock::now();
           bytes = rtcl::scene_to_bytes(scene);
           encode_ms = ms_since(t);
@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
         double local[2] = {ms_since(t), 0.0};
         if (world.rank != 0) {
           Clock::time_point d = Clock::now();
-          rtcl::Scene back = rtcl::scene_from_bytes(bytes, "broadcast");
+          rtcl::SceneDescription back = rtcl::scene_from_bytes(bytes, "broadcast");
           local[1] = ms_since(d);
         }
         double slowest[2] = {0.0, 0.0};

@@ -1,6 +1,6 @@
 // rtcl's public API in one include (docs/api.md): devices, geometry from
 // arrays, acceleration structures and their queries on host arrays or
-// OpenCL buffers, errors.
+// OpenCL buffers, scenes of meshes and instances, errors.
 #pragma once
 
 #include "rtcl/aabb.hpp"
@@ -12,3 +12,4 @@
 #include "rtcl/opencl.hpp"
 #include "rtcl/precision.hpp"
 #include "rtcl/queries.hpp"
+#include "rtcl/scene.hpp"

@@ -1,157 +1,18 @@
-/* 8-wide BVH traversal, one ray per work-item (the shape of Embree's
- * single-ray BVH8 traversal, Wald et al. 2014, "Embree: a kernel framework
- * for efficient CPU ray tracing"): the eight child boxes of a node are tested
- * at once in float8 lanes (intersect_boxes8); leaves are blocks of eight
- * primitives, also tested in float8 lanes.
- *
- * Closest hit: the children a ray enters are pushed sorted by entry
- * distance, nearest on top, and the top is taken next (kept in registers,
- * never stored: shared/bvh8_stack.h); an entry popped with an entry
- * distance beyond the current hit is skipped. Any hit: pushed in
- * lane order, and the first hit ends the traversal.
- *
- * Stack: a node with k children pushes at most k - 1 entries and takes the
- * nearest directly (as pushing k and popping one), so the stack never
- * holds more than, over all nodes v, the sum of
- * (children - 1) over v's ancestors plus v's children. The host computes
- * that bound from the tree (flatten_bvh8) and compiles with
- * -DRTCL_STACK_SIZE >= it.
- *
- * Shape for PoCL (CPU), where each work-item runs as scalar code around the
- * explicit float8 operations: the children are pushed by a per-lane branch
- * with a constant lane index (extracted from registers), the fastest form
- * there (docs/benchmarks.md); the traversal stays a separate function (its
- * private arrays stay on the native stack instead of becoming per-work-item
- * arrays).
- *
- * Mixed volumes (the "bvh-mixed" structure): a node with filter_of[node]
- * >= 0 (RTCL_FILTER_REF of shared/layouts.h) also filters the children its
- * boxes let through by the record of one kind: bounding spheres
- * (RTCL_BVH_SPHERES, shared/sphere_filter8.h), body-diagonal k-DOP slabs
- * (RTCL_BVH_KDOP, shared/kdop_filter8.h) or oriented boxes (RTCL_BVH_OBB,
- * shared/obb_filter8.h). Each define is passed only when some node uses
- * that kind; each kind's record array is an argument only then, and
- * without any of them the kernel has no filter code and no extra
- * arguments. */
+/* 8-wide BVH, one ray per work-item: the traversal of shared/bvh8_traverse.h
+ * (eight child boxes of a node tested at once in float8 lanes, leaves of
+ * eight primitives tested in float8 lanes) as the structure's trace kernels
+ * (shared/trace.h), with the occluder cache for any hit. */
 /* The leaves' triangle test inlined into the traversal (shared/triangle.h):
- * the lanes' arithmetic and the block's loads around it, which PoCL would
- * otherwise keep as calls that pass their float8 values through memory. */
+ * the lanes' arithmetic, 5-10% more rays/s than the call on the bunny, sponza
+ * and sibenik, and the block's loads around it, 1-2% more (README,
+ * "Results"). */
 #define RTCL_INLINE_TRIANGLE_LANES
 #define RTCL_INLINE_TRIANGLE_BLOCK
-/* The ray setup inlined into the kernel (shared/ray.h), for the same
- * reason. */
+/* The ray setup inlined into the kernel (shared/ray.h): 0.97-1.14x the
+ * kernel time on the twelve bench/ sets, above 1.03x on eleven (README,
+ * "Kernel levers on the single-ray BVH"). */
 #define RTCL_INLINE_RAY_SETUP
-#include "shared/bvh8_stack.h"
-#include "shared/trace.h"
-#if defined(RTCL_BVH_SPHERES) || defined(RTCL_BVH_KDOP) || defined(RTCL_BVH_OBB)
-#define RTCL_BVH_FILTERS
-#define BVH_FILTER_OF_PARAM , global const int *filter_of
-#define BVH_FILTER_OF_ARG , filter_of
-#else
-#define BVH_FILTER_OF_PARAM
-#define BVH_FILTER_OF_ARG
-#endif
-#ifdef RTCL_BVH_SPHERES
-#include "shared/sphere_filter8.h"
-#define BVH_SPHERE_PARAM , global const Bvh8Spheres *sphere_filters
-#define BVH_SPHERE_ARG , sphere_filters
-#else
-#define BVH_SPHERE_PARAM
-#define BVH_SPHERE_ARG
-#endif
-#ifdef RTCL_BVH_KDOP
-#include "shared/kdop_filter8.h"
-#define BVH_KDOP_PARAM , global const Bvh8Kdop *kdop_filters
-#define BVH_KDOP_ARG , kdop_filters
-#else
-#define BVH_KDOP_PARAM
-#define BVH_KDOP_ARG
-#endif
-#ifdef RTCL_BVH_OBB
-#include "shared/obb_filter8.h"
-#define BVH_OBB_PARAM , global const Bvh8Obb *obb_filters
-#define BVH_OBB_ARG , obb_filters
-#else
-#define BVH_OBB_PARAM
-#define BVH_OBB_ARG
-#endif
-#define BVH_FILTER_PARAMS BVH_FILTER_OF_PARAM BVH_SPHERE_PARAM BVH_KDOP_PARAM BVH_OBB_PARAM
-#define BVH_FILTER_ARGS BVH_FILTER_OF_ARG BVH_SPHERE_ARG BVH_KDOP_ARG BVH_OBB_ARG
-
-#ifndef RTCL_STACK_SIZE
-#define RTCL_STACK_SIZE 64
-#endif
-
-/* Leaf `leaf` (~ a child reference: its block index times two, plus one for
- * spheres) against the ray; whether it hit. Always inlined: as a call it
- * slows the closest-hit traversal. */
-inline __attribute__((always_inline)) int bvh_test_leaf(int leaf, const TraceRay* s, HitState* h,
-                                                        global const TriangleBlock* triangles,
-                                                        global const SphereBlock* spheres) {
-#ifdef RTCL_HAS_SPHERES
-  if (leaf & 1) return intersect_spheres8(spheres + (leaf >> 1), s, h);
-#endif
-  return intersect_triangles8(triangles + (leaf >> 1), s, h);
-}
-
-/* Returns the leaf that ended an any-hit traversal, else -1. */
-__attribute__((noinline)) int bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
-                                            global const TriangleBlock* triangles,
-                                            global const SphereBlock* spheres BVH_FILTER_PARAMS) {
-#ifdef RTCL_BVH_SPHERES
-  SphereFilterRay sphere_ray;
-  sphere_filter_setup(s, &sphere_ray);
-#endif
-#ifdef RTCL_BVH_KDOP
-  KdopFilterRay kdop_ray;
-  kdop_filter_setup(s, &kdop_ray);
-#endif
-#ifdef RTCL_BVH_OBB
-  float obb_widen = obb_filter_setup(s);
-#endif
-  int stack_ref[RTCL_STACK_SIZE];
-  float stack_t[RTCL_STACK_SIZE]; /* entry distance of stack_ref's box */
-  int sp = 0;
-  int ref = 0;
-  for (;;) {
-    if (ref >= 0) {
-      global const Bvh8Node* node = nodes + ref;
-      float8 t_entry;
-#ifdef RTCL_BVH_FILTERS
-      float8 t_exit;
-      int8 hit = intersect_box_rows8((global const float8*)node->bounds, s, h->t_best, &t_entry, &t_exit);
-      int filter = filter_of[ref];
-      if (filter >= 0 && rtcl_any8(hit)) {
-        int kind = RTCL_FILTER_KIND(filter), index = RTCL_FILTER_INDEX(filter);
-#ifdef RTCL_BVH_SPHERES
-        if (kind == RTCL_FILTER_SPHERE) hit &= sphere_filter8(sphere_filters + index, s, &sphere_ray);
-#endif
-#ifdef RTCL_BVH_KDOP
-        if (kind == RTCL_FILTER_KDOP) hit &= kdop_filter8(kdop_filters + index, &kdop_ray, t_entry, t_exit);
-#endif
-#ifdef RTCL_BVH_OBB
-        if (kind == RTCL_FILTER_OBB) hit &= obb_filter8(obb_filters + index, s, obb_widen, t_entry, t_exit);
-#endif
-      }
-#else
-      int8 hit = intersect_boxes8(node, s, h->t_best, &t_entry);
-#endif
-      if (rtcl_any8(hit)) {
-        RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST
-        ref = near_entry;
-        continue;
-      }
-    } else {
-      int leaf = ~ref;
-      if (bvh_test_leaf(leaf, s, h, triangles, spheres) && RTCL_ANY_HIT) return leaf;
-    }
-    do {
-      if (sp == 0) return -1;
-      --sp;
-    } while (!RTCL_ANY_HIT && stack_t[sp] > h->t_best);
-    ref = stack_ref[sp];
-  }
-}
+#include "shared/bvh8_traverse.h"
 
 #define BVH_PARAMS                                                                                    \
   global const Bvh8Node *nodes, global const TriangleBlock *triangles, global const SphereBlock *spheres \

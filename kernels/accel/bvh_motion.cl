@@ -110,7 +110,7 @@ kernel void RTCL_TRACE_KERNEL_NAME(bvh_motion)(global const Ray* rays, global Hi
   uint i = get_global_id(0);
   if (i >= ray_count) return;
   float tau = times[i * time_stride + time_offset];
-  tau = tau >= 0.0f ? fmin(tau, 1.0f) : 0.0f;
+  tau = rtcl_is_nan(tau) ? 0.0f : fmin(fmax(tau, 0.0f), 1.0f); /* a bit test: fast math assumes no NaN */
   TraceRay s;
   HitState h;
   if (begin_trace(rays, i, &s, &h))

@@ -249,6 +249,48 @@ typedef struct KdHeader {
   rtcl_i32 unused[3];
 } KdHeader;
 
+/* Two-level scenes (src/rtcl/scene/two_level.hpp, kernels/accel/instances.cl).
+ * The top level is an array of Bvh8Node records over the instances' world
+ * boxes (root: node 0) whose child references are an inner node (>= 0),
+ * RTCL_CHILD_EMPTY, or instance k as ~k. The bottom levels, one 8-wide BVH
+ * per mesh in the BVH structure's layout, are concatenated: mesh b's nodes,
+ * triangle blocks and sphere blocks start at BottomLevel b's offsets (in
+ * records), and its child references are relative to them. 16 bytes. */
+typedef struct BottomLevel {
+  rtcl_u32 node_offset, triangle_offset, sphere_offset;
+  rtcl_u32 unused;
+} BottomLevel;
+
+/* One instance of a bottom level. A static one turns the world ray (o, d)
+ * into its mesh's space as o' = to_object * (o - translation),
+ * d' = to_object * d (float, in that order: o - translation is small for a
+ * ray near the instance however far it lies), to_object being the inverse
+ * of the linear part of its object-to-world transform (rows, the double
+ * inverse rounded to float) and translation that transform's translation.
+ * RTCL_INSTANCE_LINEAR_IDENTITY: to_object is exactly the identity and the
+ * ray's direction is used as is. RTCL_INSTANCE_MOVING: the transform is
+ * InstanceMotion `motion`'s at the ray's time (to_object and translation
+ * unused). user_id is what hits report. 64 bytes. */
+#define RTCL_INSTANCE_LINEAR_IDENTITY 1u
+#define RTCL_INSTANCE_MOVING 2u
+typedef struct InstanceRecord {
+  float to_object[9];
+  float translation[3];
+  rtcl_u32 bottom;  /* index of its BottomLevel */
+  rtcl_u32 user_id;
+  rtcl_u32 flags;
+  rtcl_u32 motion;  /* RTCL_INSTANCE_MOVING: index of its InstanceMotion */
+} InstanceRecord;
+
+/* A moving instance's object-to-world transforms at times 0 (open) and 1
+ * (close), 3x4 row-major (x' = m[0] x + m[1] y + m[2] z + m[3], ...). At
+ * time tau its transform is open + tau * (close - open), element by element
+ * in float, so every point of the mesh moves on a straight line. 96 bytes. */
+typedef struct InstanceMotion {
+  float open[12];
+  float close[12];
+} InstanceMotion;
+
 #ifndef __OPENCL_VERSION__
 } /* namespace rtcl */
 #endif

@@ -84,7 +84,7 @@ auto as_value_error(Fn&& fn) {
 
 // None: the built-in default scene; "default" or "showcase": that built-in
 // scene; anything else (a str or an os.PathLike): a scene file.
-Scene read_scene(py::handle scene) {
+SceneDescription read_scene(py::handle scene) {
   if (scene.is_none()) return builtin_scene("default");
   std::string path;
   if (py::isinstance<py::str>(scene)) {
@@ -102,7 +102,7 @@ Scene read_scene(py::handle scene) {
   return as_value_error([&] { return load_scene(path); });
 }
 
-Image render_image(const Device& device, const Scene& scene, const RenderArgs& a) {
+Image render_image(const Device& device, const SceneDescription& scene, const RenderArgs& a) {
   RenderSettings settings;
   settings.width = static_cast<std::uint32_t>(a.width);
   settings.height = a.height > 0 ? static_cast<std::uint32_t>(a.height) : default_height(scene.camera, settings.width);
@@ -197,7 +197,7 @@ void bind_render(py::module_& m) {
         a.precision = std::move(precision);
         a.batch = batch;
         check_args(a);
-        Scene scene = read_scene(scene_arg);
+        SceneDescription scene = read_scene(scene_arg);
         if (!scene.notes.empty()) {
           py::object warn = py::module_::import("warnings").attr("warn");
           for (const std::string& note : scene.notes) warn("rtcl: note: " + note);
@@ -219,7 +219,7 @@ void bind_render(py::module_& m) {
 float32, linear RGB, row 0 at the top.
 
 scene: None (the built-in default scene), "default" or "showcase" (built-in
-    scenes), or the path of a scene file (JSON, README "Scene files").
+    scenes), or the path of a scene file (JSON, docs/file-formats.md).
 width, height: pixels (height None: width / the camera's aspect).
 spp: samples per pixel. depth: reflection/refraction bounces.
 sampler: "stratified", "random" or "sobol"; seed: of every sample pattern.

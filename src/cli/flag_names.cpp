@@ -60,7 +60,7 @@ Device open_device_flag(const std::string& selector) {
   }
 }
 
-Scene builtin_scene_flag(const std::string& name) {
+SceneDescription builtin_scene_flag(const std::string& name) {
   try {
     return builtin_scene(name);
   } catch (const Error& e) {

@@ -13,7 +13,7 @@
 #include "rtcl/device.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/precision.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl::cli {
 
@@ -37,7 +37,7 @@ Device open_device_flag(const std::string& selector);
 
 // builtin_scene(name) under "--builtin NAME": "--builtin x: unknown
 // built-in scene (known: default, showcase)".
-Scene builtin_scene_flag(const std::string& name);
+SceneDescription builtin_scene_flag(const std::string& name);
 
 // The image formats --output takes, by extension: 8-bit sRGB and linear
 // float ones (rtcl/render/image.hpp writes them), e.g. ".png, .jpg, ...".

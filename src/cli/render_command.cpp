@@ -44,7 +44,7 @@ std::string join(const std::vector<std::string>& items) {
 // spheres or area lights.
 void run_beam(const RenderOptions& o) {
   check_image_extension_flag(o.output);
-  Scene scene = load_render_scene(o);
+  SceneDescription scene = load_render_scene(o);
   beam::check_beam_scene(scene);
   check_image_output_flag(o.output);
   RenderPlan plan = plan_render(o, scene);
@@ -118,7 +118,7 @@ void run(const RenderOptions& o) {
     if (mpi_supported()) return render_distributed(o);
   }
   if (!o.accel.empty()) parse_accel_flag(o.accel);  // before the scene is loaded
-  Scene scene = load_render_scene(o);
+  SceneDescription scene = load_render_scene(o);
   RenderPlan plan = plan_render(o, scene);
   RenderUnits units = plan_units(o, scene, plan.settings.spp);  // checks the output paths before the long work
   Device device = open_device_flag(o.device);
@@ -148,32 +148,32 @@ void run(const RenderOptions& o) {
   }
 }
 
-Scene read_scene_with_lights(const RenderOptions& o, LightNotice* notice) {
+SceneDescription read_scene_with_lights(const RenderOptions& o, LightNotice* notice) {
   if (!o.scene.empty() && !o.builtin.empty())
     throw UsageError("--builtin " + o.builtin + ": give a scene file or a built-in scene, not both (scene file " +
                      o.scene + ")");
-  Scene scene = o.scene.empty() ? builtin_scene_flag(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
+  SceneDescription scene = o.scene.empty() ? builtin_scene_flag(o.builtin.empty() ? "default" : o.builtin) : load_scene(o.scene);
   *notice = default_lights(scene, o.method != "beam");
   return scene;
 }
 
 }  // namespace
 
-Scene read_render_scene(const RenderOptions& o) {
+SceneDescription read_render_scene(const RenderOptions& o) {
   LightNotice ignored;
   return read_scene_with_lights(o, &ignored);
 }
 
-Scene load_render_scene(const RenderOptions& o) {
+SceneDescription load_render_scene(const RenderOptions& o) {
   LightNotice notice;
-  Scene scene = read_scene_with_lights(o, &notice);
+  SceneDescription scene = read_scene_with_lights(o, &notice);
   for (const std::string& note : scene.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   if (!notice.note.empty()) std::fprintf(stderr, "rtcl: note: %s\n", notice.note.c_str());
   if (!notice.warning.empty()) std::fprintf(stderr, "rtcl: warning: %s\n", notice.warning.c_str());
   return scene;
 }
 
-RenderPlan plan_render(const RenderOptions& o, const Scene& scene) {
+RenderPlan plan_render(const RenderOptions& o, const SceneDescription& scene) {
   RenderPlan plan;
   RenderSettings& settings = plan.settings;
   settings.width = o.width;

@@ -8,7 +8,7 @@
 
 #include "rtcl/accel.hpp"
 #include "rtcl/render/renderer.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl::cli {
 
@@ -59,14 +59,14 @@ struct RenderPlan {
   AccelConfig config;
   std::string accel;
 };
-RenderPlan plan_render(const RenderOptions& o, const Scene& scene);
+RenderPlan plan_render(const RenderOptions& o, const SceneDescription& scene);
 
 // The scene the options name: the scene file, else the --builtin scene
 // (default: "default"), its notes printed on stderr. Throws Error for a
 // file and --builtin both, or an unknown built-in name.
-Scene load_render_scene(const RenderOptions& o);
+SceneDescription load_render_scene(const RenderOptions& o);
 // The same without printing the notes (every rank but the first).
-Scene read_render_scene(const RenderOptions& o);
+SceneDescription read_render_scene(const RenderOptions& o);
 
 // The summary line(s) on stdout: rays, time and rate; with --verbose the
 // stage times. `devices`: the device name, or how many ranks and devices.

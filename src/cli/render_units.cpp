@@ -67,7 +67,7 @@ std::string expand_output_pattern(const std::string& pattern, std::int64_t value
   return pattern.substr(0, f->at) + number + pattern.substr(f->at + f->length);
 }
 
-RenderUnits plan_units(const RenderOptions& o, const Scene& scene, std::uint32_t spp) {
+RenderUnits plan_units(const RenderOptions& o, const SceneDescription& scene, std::uint32_t spp) {
   RenderUnits out;
   if (!o.frames.empty() && !o.spp_sweep.empty())
     throw UsageError("--frames " + o.frames + ": give --frames or --spp-sweep, not both");
@@ -130,9 +130,9 @@ RenderUnits plan_units(const RenderOptions& o, const Scene& scene, std::uint32_t
   return out;
 }
 
-Scene unit_scene(const Scene& scene, const RenderUnits& units, const RenderUnit& unit) {
+SceneDescription unit_scene(const SceneDescription& scene, const RenderUnits& units, const RenderUnit& unit) {
   if (units.kind != UnitKind::frames) return scene;
-  Scene s = scene;
+  SceneDescription s = scene;
   const double shift = static_cast<double>(unit.frame) * units.frame_time;
   s.camera.shutter_open = static_cast<float>(scene.camera.shutter_open + shift);
   s.camera.shutter_close = static_cast<float>(scene.camera.shutter_close + shift);

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "render_options.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl::cli {
 
@@ -42,11 +42,11 @@ struct RenderUnits {
 // several files (or with one while it names one); and a frame whose shutter
 // interval makes some motion singular (naming the frame and the object's
 // motion key). Checks each output path (check_image_output_flag).
-RenderUnits plan_units(const RenderOptions& o, const Scene& scene, std::uint32_t spp);
+RenderUnits plan_units(const RenderOptions& o, const SceneDescription& scene, std::uint32_t spp);
 
 // The scene of a unit: for a frame, the camera's shutter moved to the
 // frame's interval (checked by plan_units); otherwise the scene itself.
-Scene unit_scene(const Scene& scene, const RenderUnits& units, const RenderUnit& unit);
+SceneDescription unit_scene(const SceneDescription& scene, const RenderUnits& units, const RenderUnit& unit);
 
 // `pattern` with its one %d / %0Nd field replaced by `value`.
 std::string expand_output_pattern(const std::string& pattern, std::int64_t value);

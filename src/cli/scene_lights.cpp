@@ -16,7 +16,7 @@ struct Emitters {
 // The emitting triangles of the scene's meshes at keyframe 0 (their
 // transform), as expand_emissive_lights finds them: emission > 0 in some
 // channel and a non-zero area.
-Emitters emitters_of(const Scene& scene) {
+Emitters emitters_of(const SceneDescription& scene) {
   Emitters out;
   for (const SceneMesh& mesh : scene.meshes)
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -41,7 +41,7 @@ std::string number(double x) {
 
 }  // namespace
 
-LightNotice default_lights(Scene& scene, bool area_lights) {
+LightNotice default_lights(SceneDescription& scene, bool area_lights) {
   LightNotice notice;
   if (!scene.lights.empty()) return notice;
   const Emitters e = emitters_of(scene);

@@ -9,7 +9,7 @@
 
 #include <string>
 
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl::cli {
 
@@ -21,6 +21,6 @@ struct LightNotice {
 // For a scene with no light: adds the emissive light when it has emissive
 // triangles and `area_lights` (the method renders area lights), and says
 // what it did. A scene with a light is left as it is (no notice).
-LightNotice default_lights(Scene& scene, bool area_lights);
+LightNotice default_lights(SceneDescription& scene, bool area_lights);
 
 }  // namespace rtcl::cli

@@ -34,5 +34,9 @@ static_assert(sizeof(OctreePtrHeader) == 240 && offsetof(OctreePtrHeader, lower)
               offsetof(OctreePtrHeader, root) == 224);
 static_assert(sizeof(KdNode) == 8 && offsetof(KdNode, data) == 4);
 static_assert(sizeof(KdHeader) == 48 && offsetof(KdHeader, upper) == 16 && offsetof(KdHeader, lane_stride) == 32);
+static_assert(sizeof(BottomLevel) == 16 && offsetof(BottomLevel, sphere_offset) == 8);
+static_assert(sizeof(InstanceRecord) == 64 && offsetof(InstanceRecord, translation) == 36 &&
+              offsetof(InstanceRecord, bottom) == 48 && offsetof(InstanceRecord, motion) == 60);
+static_assert(sizeof(InstanceMotion) == 96 && offsetof(InstanceMotion, close) == 48);
 
 }  // namespace rtcl

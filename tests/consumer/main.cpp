@@ -1,7 +1,8 @@
 // An application that already owns its OpenCL objects (made with the C API)
 // and uses rtcl as its ray-tracing backend: it adopts its context and queue,
 // builds a structure over its own arrays, and traces rays from its own cl_mem
-// buffers into its own cl_mem buffers, then the same rays from host arrays.
+// buffers into its own cl_mem buffers, then the same rays from host arrays,
+// and a scene of two instances of its mesh.
 // Only the public umbrella header. Exits 0 when the answers are right.
 #include <rtcl/rtcl.hpp>
 
@@ -101,6 +102,24 @@ int main() try {
   const float tmax[] = {inf, inf, 1.5f};
   std::vector<std::uint8_t> blocked = accel->occluded(rtcl::Rays(origins, directions, {}, tmax));
   expect(blocked == std::vector<std::uint8_t>{1, 0, 0}, name + " host arrays: occluded, free, free");
+
+  // The quad as a mesh of a scene, placed twice: as it is and moved by
+  // (10, 0, 0), each instance reporting its user id.
+  {
+    rtcl::Scene scene(backend);
+    rtcl::MeshId mesh = scene.add_mesh(quad);
+    scene.add_instance({mesh, rtcl::Transform::identity(), std::nullopt, 7u});
+    scene.add_instance({mesh, rtcl::Transform::translate(10, 0, 0), std::nullopt, 8u});
+    rtcl::CommitStats built = scene.commit();
+    expect(built.bottom_levels_built == 1 && built.top_level_built, "scene: one bottom level and the top level");
+    const rtcl::Ray scene_rays[2] = {{0.25f, 0.5f, -2.0f, 0.0f, 0.0f, 1.0f, 0.0f, inf},
+                                     {10.25f, 0.5f, -2.0f, 0.0f, 0.0f, 1.0f, 0.0f, inf}};
+    std::vector<std::uint32_t> ids(2);
+    std::vector<rtcl::Hit> scene_hits = scene.intersect(std::span<const rtcl::Ray>(scene_rays, 2), ids);
+    expect(scene_hits[0].prim == 1 && scene_hits[1].prim == 1 && scene_hits[1].t == 2.0f,
+           "scene: both instances hit triangle 1 at t = 2");
+    expect(ids[0] == 7u && ids[1] == 8u, "scene: instance ids 7 and 8");
+  }
 
   // A hit buffer one record short is refused before anything runs.
   cl_mem short_hits = clCreateBuffer(context, CL_MEM_WRITE_ONLY, 2 * sizeof(rtcl::Hit), nullptr, &status);

@@ -38,7 +38,7 @@ class Tracer {
   // A moving scene's primitives are its keyframes at the camera's shutter
   // open and close (flattened to float, as the renderer's input), each
   // sample's at open + tau * (close - open) in double.
-  Tracer(const Scene& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {
+  Tracer(const SceneDescription& scene, const RenderSettings& settings) : scene_(scene), settings_(settings) {
     const bool moves = scene_moves(scene);
     FlatScene flat = flatten(moves ? scene_at(scene, scene.camera.shutter_open) : scene);
     FlatScene end = moves ? flatten(scene_at(scene, scene.camera.shutter_close)) : flat;
@@ -267,7 +267,7 @@ class Tracer {
     return best;
   }
 
-  const Scene& scene_;
+  const SceneDescription& scene_;
   RenderSettings settings_;
   std::vector<std::uint32_t> material_;
   std::vector<Light> lights_;  // emissive lights expanded into triangles
@@ -277,7 +277,7 @@ class Tracer {
 
 }  // namespace
 
-ReferenceImage reference_render(const Scene& scene, const RenderSettings& settings, double ambiguity_px) {
+ReferenceImage reference_render(const SceneDescription& scene, const RenderSettings& settings, double ambiguity_px) {
   Tracer tracer(scene, settings);
   CameraFrame frame = camera_frame(scene.camera, settings.width, settings.height);
   ReferenceImage out;

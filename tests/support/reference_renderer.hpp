@@ -12,7 +12,7 @@
 
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/renderer.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl::test {
 
@@ -25,7 +25,7 @@ struct ReferenceImage {
   std::vector<std::uint8_t> ambiguous;
 };
 
-ReferenceImage reference_render(const Scene& scene, const RenderSettings& settings, double ambiguity_px = 0.01);
+ReferenceImage reference_render(const SceneDescription& scene, const RenderSettings& settings, double ambiguity_px = 0.01);
 
 struct ImageDifference {
   double rmse = 0.0;                 // over all pixels and channels

@@ -146,7 +146,7 @@ void run(MpiWorld& world, const RenderOptions& o) {
   Fault fault = fault_from_environment();
 
   // --- rank 0 decides; the decision (or its failure) goes to every rank ---
-  Scene scene;
+  SceneDescription scene;
   RenderPlan plan;
   RenderUnits units;
   std::string header_text;

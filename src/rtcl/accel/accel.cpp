@@ -233,8 +233,12 @@ void AccelAccess::require_plain_bvh8(const Accel& accel, const char* call) {
 
 cl::Event AccelAccess::launch(const Accel& accel, const cl::Kernel& kernel, std::size_t items,
                               const std::vector<cl::Event>& wait) {
+  return launch_items(accel.device_, kernel, items, wait);
+}
+
+cl::Event launch_items(const Device& device, const cl::Kernel& kernel, std::size_t items,
+                       const std::vector<cl::Event>& wait) {
   constexpr std::size_t kGroup = 64;
-  const Device& device = accel.device_;
   cl::Event done;
   if (items == 0) {
     device.queue().enqueueMarkerWithWaitList(&wait, &done);

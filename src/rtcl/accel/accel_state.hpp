@@ -101,5 +101,10 @@ struct AccelAccess {
   }
 };
 
+// AccelAccess::launch on the device's queue, for kernels outside a
+// structure (the two-level scene's, src/rtcl/scene/two_level.hpp).
+cl::Event launch_items(const Device& device, const cl::Kernel& kernel, std::size_t items,
+                       const std::vector<cl::Event>& wait);
+
 }  // namespace detail
 }  // namespace rtcl

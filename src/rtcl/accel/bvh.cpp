@@ -207,18 +207,28 @@ std::vector<std::string> bvh_defines(const Geometry& geometry, const Bvh8& bvh) 
   return defines;
 }
 
-std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config,
-                                std::string name, const AccelConfig& accel_config) {
+BuiltBvh build_bvh(const Geometry& geometry, const BvhConfig& config) {
   auto start = std::chrono::steady_clock::now();
   GeometryReport report = validate(geometry, ZeroAreaTest::by_caller);
   std::size_t stored = 0;
   BuildTree tree = build_binary_bvh(geometry, config, &stored);
   report.zero_area_triangles = geometry.primitive_count() - stored;
-  Bvh8 bvh = flatten_bvh8(tree, geometry, flatten_options(config));
-  AccelStats stats = bvh_stats(geometry, report, bvh, start);
-  std::vector<std::string> defines = bvh_defines(geometry, bvh);
-  return std::make_unique<BvhAccel>(device, std::move(name), config, std::move(defines), bvh, geometry, stats,
+  BuiltBvh built;
+  built.bvh = flatten_bvh8(tree, geometry, flatten_options(config));
+  built.stats = bvh_stats(geometry, report, built.bvh, start);
+  built.defines = bvh_defines(geometry, built.bvh);
+  return built;
+}
+
+std::unique_ptr<Accel> make_bvh_accel(const Device& device, const BuiltBvh& built, const Geometry& geometry,
+                                      const BvhConfig& config, std::string name, const AccelConfig& accel_config) {
+  return std::make_unique<BvhAccel>(device, std::move(name), config, built.defines, built.bvh, geometry, built.stats,
                                     accel_config);
+}
+
+std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config,
+                                std::string name, const AccelConfig& accel_config) {
+  return make_bvh_accel(device, build_bvh(geometry, config), geometry, config, std::move(name), accel_config);
 }
 
 namespace {

@@ -152,6 +152,20 @@ std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size);
 std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config = {},
                                 std::string name = "bvh", const AccelConfig& accel_config = {});
 
+// make_bvh in its two steps, for a caller that keeps the host image (the
+// two-level scene's bottom levels, src/rtcl/scene/two_level.hpp): the build
+// and flatten over the geometry (validated here, as make_bvh does), and the
+// structure over that image (uploaded; the image may go after).
+struct BuiltBvh {
+  Bvh8 bvh;
+  AccelStats stats;
+  std::vector<std::string> defines;  // bvh_defines
+};
+BuiltBvh build_bvh(const Geometry& geometry, const BvhConfig& config = {});
+std::unique_ptr<Accel> make_bvh_accel(const Device& device, const BuiltBvh& built, const Geometry& geometry,
+                                      const BvhConfig& config = {}, std::string name = "bvh",
+                                      const AccelConfig& accel_config = {});
+
 // The options of the SAH-built structures ("bvh", "bvh-packet"), and the
 // BvhConfig a structure's resolved options (make_accel: every declared
 // option present) give (for structures built on the BVH, bvh_mixed.hpp).

@@ -211,7 +211,7 @@ Refraction refraction_at(const ScreenSpace& screen, const World& world, const Sc
 }
 
 // The beam tree, level by level: one device launch per level.
-Visible visible_pieces(const Device& device, const Scene& scene, const FlatScene& flat, const BeamSettings& s,
+Visible visible_pieces(const Device& device, const SceneDescription& scene, const FlatScene& flat, const BeamSettings& s,
                        bool primary_only = false) {
   Visible v;
   const Geometry& g = flat.geometry;
@@ -295,7 +295,7 @@ double max_abs3(const dvec3& p) { return std::max(std::abs(p.x), std::max(std::a
 
 }  // namespace
 
-void check_beam_scene(const Scene& scene) {
+void check_beam_scene(const SceneDescription& scene) {
   if (!scene.spheres.empty())
     throw Error(scene.source + ": --method beam traces polygons only, and the scene has " +
                 std::to_string(scene.spheres.size()) + " sphere(s); remove them or use --method ray");
@@ -312,7 +312,7 @@ void check_beam_scene(const Scene& scene) {
                   "' is glossy; --method beam traces mirror reflection and refraction only (use --method ray)");
 }
 
-std::vector<CoverageEntry> beam_coverage(const Device& device, const Scene& scene, const BeamSettings& settings) {
+std::vector<CoverageEntry> beam_coverage(const Device& device, const SceneDescription& scene, const BeamSettings& settings) {
   check_beam_scene(scene);
   validate(scene);
   FlatScene flat = flatten(scene);
@@ -322,7 +322,7 @@ std::vector<CoverageEntry> beam_coverage(const Device& device, const Scene& scen
   return out;
 }
 
-Image render_beam(const Device& device, const Scene& scene, const BeamSettings& settings, BeamStats* stats) {
+Image render_beam(const Device& device, const SceneDescription& scene, const BeamSettings& settings, BeamStats* stats) {
   auto start = std::chrono::steady_clock::now();
   check_beam_scene(scene);
   validate(scene);

@@ -30,7 +30,7 @@
 #include "rtcl/beam/beam_clip_host.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/render/image.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl::beam {
 
@@ -67,9 +67,9 @@ struct BeamStats {
 // Throws Error naming scene.source when the scene has spheres (beam tracing
 // takes polygons only), an area light (point lights only), a glossy
 // material (no glossy beams) or a moving object (a static scene).
-void check_beam_scene(const Scene& scene);
+void check_beam_scene(const SceneDescription& scene);
 
-Image render_beam(const Device& device, const Scene& scene, const BeamSettings& settings, BeamStats* stats = nullptr);
+Image render_beam(const Device& device, const SceneDescription& scene, const BeamSettings& settings, BeamStats* stats = nullptr);
 
 // Per pixel (row-major), the coverage of every visible triangle id by the
 // fragments of the viewing beam's device walk: for tests.
@@ -77,6 +77,6 @@ struct CoverageEntry {
   std::uint32_t pixel, prim;
   double area;  // square pixels, in (0, 1]
 };
-std::vector<CoverageEntry> beam_coverage(const Device& device, const Scene& scene, const BeamSettings& settings);
+std::vector<CoverageEntry> beam_coverage(const Device& device, const SceneDescription& scene, const BeamSettings& settings);
 
 }  // namespace rtcl::beam

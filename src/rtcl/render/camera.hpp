@@ -6,7 +6,7 @@
 
 #include <glm/glm.hpp>
 
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl {
 

@@ -67,7 +67,7 @@ DeviceLight pack(const Light& l) {
 
 }  // namespace
 
-std::vector<std::string> shade_defines(const Scene& scene, const FlatScene& flat) {
+std::vector<std::string> shade_defines(const SceneDescription& scene, const FlatScene& flat) {
   std::set<std::uint32_t> used(flat.material.begin(), flat.material.end());
   bool reflection = false, refraction = false, glossy = false, area = false;
   for (std::uint32_t m : used) {
@@ -85,7 +85,7 @@ std::vector<std::string> shade_defines(const Scene& scene, const FlatScene& flat
   return defines;
 }
 
-std::vector<std::string> generate_defines(const Scene& scene) {
+std::vector<std::string> generate_defines(const SceneDescription& scene) {
   if (scene.camera.aperture > 0.0f) return {"RTCL_HAS_LENS"};
   return {};
 }
@@ -116,7 +116,7 @@ ShadeRecords shade_records(const FlatScene& flat) {
 
 }  // namespace
 
-DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat, const FlatScene* close) {
+DeviceScene upload_scene(const Device& device, const SceneDescription& scene, const FlatScene& flat, const FlatScene* close) {
   const Geometry& g = flat.geometry;
   ShadeRecords records = shade_records(flat);
   std::vector<DeviceMaterial> materials;

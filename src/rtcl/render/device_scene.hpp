@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "rtcl/device.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl {
 
@@ -32,11 +32,11 @@ struct DeviceScene {
   std::vector<std::string> generate_defines;
 };
 
-std::vector<std::string> shade_defines(const Scene& scene, const FlatScene& flat);
-std::vector<std::string> generate_defines(const Scene& scene);
+std::vector<std::string> shade_defines(const SceneDescription& scene, const FlatScene& flat);
+std::vector<std::string> generate_defines(const SceneDescription& scene);
 // `flat`: the primitives (at shutter open when the scene moves); `close`:
 // the same primitives at shutter close, for a moving scene only.
-DeviceScene upload_scene(const Device& device, const Scene& scene, const FlatScene& flat,
+DeviceScene upload_scene(const Device& device, const SceneDescription& scene, const FlatScene& flat,
                          const FlatScene* close = nullptr);
 
 }  // namespace rtcl

@@ -49,7 +49,7 @@ void check_settings(const RenderSettings& s) {
 }
 
 // Shadow slots per shaded ray: one per point light, `light_samples` per area light.
-std::uint32_t shadow_slots_per_ray(const Scene& scene, std::uint32_t light_samples) {
+std::uint32_t shadow_slots_per_ray(const SceneDescription& scene, std::uint32_t light_samples) {
   std::uint32_t slots = 0;
   for (const Light& l : scene.lights) slots += l.area() ? light_samples : 1u;
   return slots;
@@ -69,7 +69,7 @@ ImageRegion checked_region(const RenderSettings& s, const ImageRegion& r) {
 
 struct Renderer::State {
   Device device;
-  Scene scene;
+  SceneDescription scene;
   FlatScene flat;
   std::unique_ptr<Accel> accel;       // static scenes
   std::unique_ptr<MotionBvh> motion;  // moving scenes
@@ -102,10 +102,10 @@ struct Renderer::State {
   std::vector<cl::Event> camera_traces, secondary_traces, shadow_traces, generates, shades, accumulates;
   std::vector<std::pair<cl::Event, cl::Event>> compacts;  // first and last kernel of both compactions
 
-  State(const Device& d, const Scene& s) : device(d), scene(s), queue(d), next(d), shadows(d) {}
+  State(const Device& d, const SceneDescription& s) : device(d), scene(s), queue(d), next(d), shadows(d) {}
 };
 
-Renderer::Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config,
+Renderer::Renderer(const Device& device, const SceneDescription& scene, std::string_view accel_name, const AccelConfig& config,
                    MotionBounds motion_bounds)
     : s_(std::make_unique<State>(device, scene)) {
   if (!scene_moves(scene)) {
@@ -119,7 +119,7 @@ Renderer::Renderer(const Device& device, const Scene& scene, std::string_view ac
                   " has moving objects, which only the motion BVH traces (accel bvh)");
     const double open = scene.camera.shutter_open, close = scene.camera.shutter_close;
     check_motion(scene, open, close);
-    Scene at_open = scene_at(scene, open), at_close = scene_at(scene, close);
+    SceneDescription at_open = scene_at(scene, open), at_close = scene_at(scene, close);
     s_->flat = flatten(at_open);
     FlatScene end = flatten(at_close);
     s_->scene.lights = expand_emissive_lights(at_open, s_->flat);

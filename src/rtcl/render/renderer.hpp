@@ -26,7 +26,7 @@
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/render_layouts.hpp"
 #include "rtcl/render/sampling_options.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl {
 
@@ -109,7 +109,7 @@ class Renderer {
   // `motion_bounds` (accel_name must then be "bvh"; the kernels get
   // RTCL_HAS_MOTION and each ray its sample's time); a static scene has no
   // time code. Throws Error.
-  Renderer(const Device& device, const Scene& scene, std::string_view accel_name, const AccelConfig& config = {},
+  Renderer(const Device& device, const SceneDescription& scene, std::string_view accel_name, const AccelConfig& config = {},
            MotionBounds motion_bounds = MotionBounds::interpolated);
   ~Renderer();
   Renderer(const Renderer&) = delete;

@@ -87,8 +87,8 @@ SceneMesh glass_block() {
 
 }  // namespace
 
-Scene default_scene() {
-  Scene s;
+SceneDescription default_scene() {
+  SceneDescription s;
   s.source = "default scene";
   s.camera.position = {0.0f, 1.0f, 3.9f};
   s.camera.look_at = {0.0f, 1.0f, 0.0f};

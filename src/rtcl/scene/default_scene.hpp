@@ -6,10 +6,10 @@
 // Needs no file.
 #pragma once
 
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl {
 
-Scene default_scene();
+SceneDescription default_scene();
 
 }  // namespace rtcl

@@ -17,20 +17,19 @@ std::string number(double x) {
   return out.str();
 }
 
-double blended_determinant(const SceneMesh& mesh, double t) { return glm::determinant(glm::dmat3(transform_at(mesh, t))); }
+}  // namespace
 
-// Whether the cubic det(blend(t)) keeps the sign of det(blend(t0)), never
-// reaching zero, on [t0, t1]: its sign at both ends and at the critical
-// points inside (the roots of its derivative) decides, since a cubic is
-// monotone between them. The cubic's coefficients come from four exact
-// samples (Lagrange interpolation at t0 .. t1).
-bool determinant_keeps_sign(const SceneMesh& mesh, double t0, double t1) {
-  double d0 = blended_determinant(mesh, t0);
+bool blend_keeps_determinant_sign(const glm::dmat3& open, const glm::dmat3& close, double t0, double t1) {
+  auto blended_determinant = [&](double t) { return glm::determinant((1.0 - t) * open + t * close); };
+  double d0 = blended_determinant(t0);
   if (!(d0 != 0.0) || !std::isfinite(d0)) return false;
   if (!(t1 > t0)) return true;
+  // The cubic's sign at both ends and at the critical points inside (the
+  // roots of its derivative), its coefficients from four exact samples
+  // (Lagrange interpolation at t0 .. t1).
   // p(s) = det(blend(t0 + s (t1 - t0))), s in [0, 1]: samples at s = 0, 1/3, 2/3, 1.
   double y[4];
-  for (int k = 0; k < 4; ++k) y[k] = blended_determinant(mesh, t0 + (t1 - t0) * k / 3.0);
+  for (int k = 0; k < 4; ++k) y[k] = blended_determinant(t0 + (t1 - t0) * k / 3.0);
   // Newton forward differences on the unit step h = 1/3 -> power basis in s.
   double a0 = y[0];
   double d1 = y[1] - y[0], d2 = y[2] - 2 * y[1] + y[0], d3 = y[3] - 3 * y[2] + 3 * y[1] - y[0];
@@ -59,9 +58,7 @@ bool determinant_keeps_sign(const SceneMesh& mesh, double t0, double t1) {
   return true;
 }
 
-}  // namespace
-
-bool scene_moves(const Scene& scene) {
+bool scene_moves(const SceneDescription& scene) {
   return std::any_of(scene.meshes.begin(), scene.meshes.end(), [](const SceneMesh& m) { return m.end_transform.has_value(); }) ||
          std::any_of(scene.spheres.begin(), scene.spheres.end(), [](const SceneSphere& s) { return s.moving; });
 }
@@ -80,8 +77,8 @@ SceneSphere sphere_at(const SceneSphere& sphere, double time) {
   return s;
 }
 
-Scene scene_at(const Scene& scene, double time) {
-  Scene out = scene;
+SceneDescription scene_at(const SceneDescription& scene, double time) {
+  SceneDescription out = scene;
   for (SceneMesh& m : out.meshes) {
     m.transform = transform_at(m, time);
     m.end_transform.reset();
@@ -90,12 +87,12 @@ Scene scene_at(const Scene& scene, double time) {
   return out;
 }
 
-void check_motion(const Scene& scene, double t0, double t1) {
+void check_motion(const SceneDescription& scene, double t0, double t1) {
   if (!std::isfinite(t0) || !std::isfinite(t1) || t0 > t1)
     throw Error(scene.source + ": camera.shutter: the interval [" + number(t0) + ", " + number(t1) +
                 "] must be finite with open <= close");
   for (const SceneMesh& m : scene.meshes)
-    if (m.end_transform && !determinant_keeps_sign(m, t0, t1))
+    if (m.end_transform && !blend_keeps_determinant_sign(glm::dmat3(m.transform), glm::dmat3(*m.end_transform), t0, t1))
       throw Error((m.motion_key.empty() ? scene.source + ": mesh " + m.name : m.motion_key) +
                   ": the blend of the two keyframe transforms is singular at some time in [" + number(t0) + ", " +
                   number(t1) + "] (the object would collapse onto a plane; a rotation of 180 degrees or more cannot "

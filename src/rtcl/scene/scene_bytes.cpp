@@ -84,7 +84,7 @@ class Reader {
 
 }  // namespace
 
-std::vector<std::byte> scene_to_bytes(const Scene& scene) {
+std::vector<std::byte> scene_to_bytes(const SceneDescription& scene) {
   Writer w;
   w.pod(magic);
   w.pod(version);
@@ -134,11 +134,11 @@ std::vector<std::byte> scene_to_bytes(const Scene& scene) {
   return std::move(w.out);
 }
 
-Scene scene_from_bytes(std::span<const std::byte> bytes, const std::string& what) {
+SceneDescription scene_from_bytes(std::span<const std::byte> bytes, const std::string& what) {
   Reader r(bytes, what);
   if (r.pod<std::uint32_t>() != magic) r.fail("another magic");
   if (std::uint32_t v = r.pod<std::uint32_t>(); v != version) r.fail("version " + std::to_string(v));
-  Scene scene;
+  SceneDescription scene;
   scene.source = r.text();
   scene.camera = r.pod<Camera>();
   scene.ambient = r.pod<glm::vec3>();

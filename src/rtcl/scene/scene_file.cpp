@@ -260,7 +260,7 @@ class SceneBuilder {
  public:
   SceneBuilder(const Reader& r, std::filesystem::path base_dir) : r_(r), base_dir_(std::move(base_dir)) {}
 
-  Scene build(const json& root) {
+  SceneDescription build(const json& root) {
     r_.object(root, "", {"camera", "ambient", "background", "lights", "materials", "objects", "accel", "precision"});
     scene_.source = r_.source();
     if (root.contains("accel")) scene_.accel = read_accel(r_, root["accel"]);
@@ -414,7 +414,7 @@ class SceneBuilder {
 
   const Reader& r_;
   std::filesystem::path base_dir_;
-  Scene scene_;
+  SceneDescription scene_;
   std::map<std::string, std::uint32_t> named_;
   std::map<std::string, LoadedMesh> meshes_;
 };
@@ -435,15 +435,15 @@ Material material_from_mtl(const MeshMaterial& mm) {
   return m;
 }
 
-Scene parse_scene(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
+SceneDescription parse_scene(const std::string& text, const std::string& source, const std::filesystem::path& base_dir) {
   Reader reader(source);
   json root = parse_strict(text, reader);
-  Scene scene = SceneBuilder(reader, base_dir).build(root);
+  SceneDescription scene = SceneBuilder(reader, base_dir).build(root);
   check_motion(scene, scene.camera.shutter_open, scene.camera.shutter_close);
   return scene;
 }
 
-Scene load_scene(const std::string& path) {
+SceneDescription load_scene(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) throw Error(path + ": is a directory, not a scene file");
   std::ifstream in(path, std::ios::binary);

@@ -11,7 +11,7 @@
 #include <string>
 
 #include "rtcl/scene/mesh_io.hpp"
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl {
 
@@ -20,11 +20,11 @@ namespace rtcl {
 // missing or unreadable file, malformed JSON (with line and column), an
 // unknown key, a value of the wrong type or out of range, a missing required
 // key, an unknown material name, or a mesh that cannot be loaded.
-Scene load_scene(const std::string& path);
+SceneDescription load_scene(const std::string& path);
 
 // The same from text; `source` names it in errors and `base_dir` resolves
 // relative mesh paths.
-Scene parse_scene(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
+SceneDescription parse_scene(const std::string& text, const std::string& source, const std::filesystem::path& base_dir);
 
 // The scene material an MTL material maps to (see above).
 Material material_from_mtl(const MeshMaterial& m);

@@ -7,12 +7,12 @@ namespace rtcl {
 
 namespace {
 
-std::uint32_t add_material(Scene& s, Material m) {
+std::uint32_t add_material(SceneDescription& s, Material m) {
   s.materials.push_back(std::move(m));
   return static_cast<std::uint32_t>(s.materials.size() - 1);
 }
 
-std::uint32_t material_named(const Scene& s, const std::string& name) {
+std::uint32_t material_named(const SceneDescription& s, const std::string& name) {
   for (std::size_t i = 0; i < s.materials.size(); ++i)
     if (s.materials[i].name == name) return static_cast<std::uint32_t>(i);
   throw Error("internal: the default scene has no material " + name);
@@ -20,8 +20,8 @@ std::uint32_t material_named(const Scene& s, const std::string& name) {
 
 }  // namespace
 
-Scene showcase_scene() {
-  Scene s = default_scene();
+SceneDescription showcase_scene() {
+  SceneDescription s = default_scene();
   s.source = "showcase scene";
   // Soft shadows: a 0.5 x 0.5 quad light just below the ceiling panel.
   Light lamp;
@@ -63,7 +63,7 @@ Scene showcase_scene() {
   return s;
 }
 
-Scene builtin_scene(const std::string& name) {
+SceneDescription builtin_scene(const std::string& name) {
   if (name == "default") return default_scene();
   if (name == "showcase") return showcase_scene();
   throw Error("builtin_scene name \"" + name + "\": unknown built-in scene (known: default, showcase)");

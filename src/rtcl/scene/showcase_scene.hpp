@@ -7,14 +7,14 @@
 // the room during the shutter (motion blur).
 #pragma once
 
-#include "rtcl/scene/scene.hpp"
+#include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl {
 
-Scene showcase_scene();
+SceneDescription showcase_scene();
 
 // The built-in scenes by name: "default", "showcase". Throws Error
 // (builtin_scene name "NAME": ...) naming the known names for another.
-Scene builtin_scene(const std::string& name);
+SceneDescription builtin_scene(const std::string& name);
 
 }  // namespace rtcl

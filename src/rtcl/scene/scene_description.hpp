@@ -22,7 +22,7 @@ namespace rtcl {
 
 struct Material {
   std::string name;
-  glm::vec3 ambient{0.0f};   // multiplied by Scene::ambient
+  glm::vec3 ambient{0.0f};   // multiplied by SceneDescription::ambient
   glm::vec3 diffuse{0.8f};   // Lambert term per light
   glm::vec3 specular{0.0f};  // Phong term per light: specular * max(0, R.V)^shininess
   float shininess = 32.0f;   // Phong exponent, >= 0
@@ -84,7 +84,7 @@ struct SceneMesh {
   std::string name;  // the file path or a built-in name: named in errors
   std::vector<glm::vec3> vertices;
   std::vector<glm::uvec3> triangles;
-  std::vector<std::uint32_t> materials;  // one per triangle, index into Scene::materials
+  std::vector<std::uint32_t> materials;  // one per triangle, index into SceneDescription::materials
   glm::dmat4 transform{1.0};             // object to world; a mirroring one keeps faces outward
   // Motion: the object-to-world transform at keyframe time 1 (`transform`
   // is keyframe 0); at time t the transform is the blend (1 - t) * transform
@@ -116,7 +116,7 @@ struct SceneSphere {
   }
 };
 
-struct Scene {
+struct SceneDescription {
   std::string source = "scene";  // the scene file, or "default scene": named in errors
   Camera camera;
   glm::vec3 ambient{0.0f};     // ambient light
@@ -141,7 +141,7 @@ struct Scene {
 // radius, a disc light without a normal, kr/kt/roughness outside [0, 1],
 // ior <= 0, a negative shininess, a material index out of range, a non-finite number anywhere,
 // or a scene with no mesh and no sphere.
-void validate(const Scene& scene);
+void validate(const SceneDescription& scene);
 
 // The world-space primitives: mesh triangles in mesh order (transformed in
 // double, rounded to float), then spheres; material[prim] for every
@@ -150,19 +150,19 @@ struct FlatScene {
   Geometry geometry;
   std::vector<std::uint32_t> material;
 };
-FlatScene flatten(const Scene& scene);
+FlatScene flatten(const SceneDescription& scene);
 
 // scene.lights with each emissive light replaced by one triangle light per
 // emitting triangle of `flat` (in primitive order), each of radiance emission
 // * color * intensity times its share of the emitters' total area (so that
 // together they are the average over the emitters' points). Throws Error
 // naming the light when no triangle emits.
-std::vector<Light> expand_emissive_lights(const Scene& scene, const FlatScene& flat);
+std::vector<Light> expand_emissive_lights(const SceneDescription& scene, const FlatScene& flat);
 
 // The scene moved by a similarity transform (rotation, uniform scale,
 // translation): camera, lights, meshes and spheres. Throws Error when
 // `transform` is not a similarity. For scale and translation tests.
-Scene transform_scene(const Scene& scene, const glm::dmat4& transform);
+SceneDescription transform_scene(const SceneDescription& scene, const glm::dmat4& transform);
 
 // The uniform scale of a similarity transform; throws Error naming `what`
 // when the 3x3 part is not a rotation times a positive scale.
