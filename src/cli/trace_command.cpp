@@ -39,7 +39,7 @@ struct TraceOptions {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point start) {
+double elapsed_ms(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
 }
 
@@ -73,7 +73,7 @@ TraceResult trace_on_device(const Accel& accel, const std::vector<Ray>& rays, st
       Clock::time_point start = Clock::now();
       cl::Event done = accel.trace(query, ray_buffer, hit_buffer, rays.size(), {}, coherence);
       done.wait();
-      double ms = ms_since(start);
+      double ms = elapsed_ms(start);
       if (result.profiled) ms = accel.last_call_ms(done);
       result.trace_ms.push_back(ms);
       if (accel.last_call_sorted()) ++result.sorted_launches;
@@ -96,7 +96,7 @@ void run_trace(const TraceOptions& options) {
   Clock::time_point load_start = Clock::now();
   LoadedMesh mesh = load_mesh(options.mesh);
   GeometryReport report = validate(mesh.geometry);
-  double load_ms = ms_since(load_start);
+  double load_ms = elapsed_ms(load_start);
   progress.clear();
   for (const std::string& note : mesh.notes) std::fprintf(stderr, "rtcl: note: %s\n", note.c_str());
   if (report.zero_area_triangles > 0)
@@ -124,7 +124,7 @@ void run_trace(const TraceOptions& options) {
   Clock::time_point build_start = Clock::now();
   std::unique_ptr<Accel> accel = make_accel(device, accel_name, mesh.geometry, config);
   progress.clear();
-  double setup_ms = ms_since(build_start);
+  double setup_ms = elapsed_ms(build_start);
   const AccelStats& stats = accel->stats();
   std::printf(
       "accel:  %s (%s precision): built in %.1f ms on the host (%.1f ms with kernel build and upload), %.1f MiB on "
