@@ -175,7 +175,7 @@ def query_bench(build, scenes, size, repeat):
     return rows
 
 
-def rtcl_bench(build, scenes, size, repeat):
+def rtcl_bench(build, scenes, size, repeat, scenes_dir):
     """`rtcl bench --accel bvh` on the three ray sets: Embree's rates
     (Mrays/s) per (scene, ray set)."""
     exe = build / "rtcl"
@@ -185,7 +185,7 @@ def rtcl_bench(build, scenes, size, repeat):
     with tempfile.TemporaryDirectory() as out:
         subprocess.run([str(exe), "bench", "--accel", "bvh", "--scene", ",".join(scenes), "--rays",
                         "primary,shadow,diffuse", "--size", str(size), "--repeat", str(repeat), "--check-rays", "0",
-                        "--device", "0", "-o", out], check=True, capture_output=True, text=True)
+                        "--device", "0", "--scenes-dir", str(scenes_dir), "-o", out], check=True, capture_output=True, text=True)
         report = json.loads((Path(out) / "bench.json").read_text())
     rates = {}
     for b in (report.get("embree") or {}).get("baselines", []):
@@ -239,7 +239,7 @@ def main():
         }
         print(f"{name}: {len(f)} triangles, {len(shadow)} shadow and diffuse rays", flush=True)
     cpp = {} if args.no_cpp else query_bench(build, scenes, args.size, args.repeat)
-    embree = {} if args.no_cpp else rtcl_bench(build, scenes, args.size, args.repeat)
+    embree = {} if args.no_cpp else rtcl_bench(build, scenes, args.size, args.repeat, args.scenes_dir)
 
     print("\n| scene | rays | Python Mrays/s | C++ host arrays | Python/C++ | Embree (2 threads) | Python/Embree |")
     print("|---|---|---|---|---|---|---|")

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "bench/support/ray_sets.hpp"
+#include "bench/support/scenes_dir.hpp"
 #include "rtcl/rtcl.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #ifdef RTCL_HAVE_EMBREE
@@ -183,7 +184,7 @@ std::vector<RTCRayHit> embree_records(const std::vector<rtcl::Ray>& rays) {
 }  // namespace
 
 int main(int argc, char** argv) try {
-  std::string scenes_dir = RTCL_BENCH_SCENES_DIR, counts_text = "1000,10000,100000";
+  std::string scenes_dir = rtcl::bench::scenes_dir(), counts_text = "1000,10000,100000";
   int size = 1024, repeat = 5;
   std::size_t forest_count = 10000;
   for (int i = 1; i < argc; ++i) {
