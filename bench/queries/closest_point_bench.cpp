@@ -26,13 +26,16 @@
 #include <vector>
 
 #include "bench/support/scenes_dir.hpp"
+#include "bench/support/timing.hpp"
 #include "rtcl/accel.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using rtcl::bench::Clock;
+using rtcl::bench::median;
+using rtcl::bench::ms_since;
 
 struct V3 {
   float x, y, z;
@@ -94,11 +97,6 @@ bool closest_point_func(RTCPointQueryFunctionArguments* args) {
     return true;  // the radius shrank
   }
   return false;
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 struct SceneRates {

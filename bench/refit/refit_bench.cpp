@@ -44,6 +44,7 @@
 #include "bench/support/ray_sets.hpp"
 #include "bench/support/scene_catalog.hpp"
 #include "bench/support/scenes_dir.hpp"
+#include "bench/support/timing.hpp"
 #include "rtcl/rtcl.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #include "rtcl/scene/procedural.hpp"
@@ -53,16 +54,9 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> values) {
-  std::sort(values.begin(), values.end());
-  return values[values.size() / 2];
-}
+using rtcl::bench::Clock;
+using rtcl::bench::median;
+using rtcl::bench::ms_since;
 
 // Median of `repeat` timed calls after one warm-up; call(k) gets the call's
 // index (0 = the warm-up).

@@ -32,6 +32,7 @@
 
 #include "bench/support/ray_sets.hpp"
 #include "bench/support/scenes_dir.hpp"
+#include "bench/support/timing.hpp"
 #include "rtcl/rtcl.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #ifdef RTCL_HAVE_EMBREE
@@ -40,16 +41,9 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-double median(std::vector<double> ms) {
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
-}
+using rtcl::bench::Clock;
+using rtcl::bench::median;
+using rtcl::bench::ms_since;
 
 // Median of `repeat` timed calls after one warm-up call.
 double median_ms(int repeat, const std::function<void()>& call) {
