@@ -224,8 +224,9 @@ std::uint8_t side_of(float lower, float upper, float p) {
 // lanes, and more than four runs or an eighth of the scene's primitives.
 // The SAH alone can leave a small scene whose walls span every plane (the
 // Cornell box's 36 triangles) in one leaf, every ray testing all of it;
-// three forced splits per path fix that, while forcing splits of every
-// node above one run lengthens the build of large scenes.
+// three forced splits per path fix that. Forcing splits of every node
+// above one run would instead lengthen the build of large scenes
+// (docs/benchmarks.md, levers).
 constexpr std::size_t kRun = 8;
 constexpr std::size_t kLargeLeaf = 4 * kRun;
 constexpr int kCostlySplits = 3;
