@@ -5,7 +5,7 @@
 # input is saved under build-fuzz/artifacts/<target>/ and must then be added
 # to tests/fuzz_regressions/<target>/ (replayed by ctest) and fixed.
 #
-#   bash scripts/fuzz.sh --ci                      # every target, 40 s each (CI)
+#   bash scripts/fuzz.sh --ci                      # every target, 30 s each (CI)
 #   bash scripts/fuzz.sh --seconds 3600 --jobs 2   # a longer campaign
 #   bash scripts/fuzz.sh --seconds 600 mesh_loader # one target
 #
@@ -19,7 +19,7 @@ jobs=1
 targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
-    --ci) seconds=40 ;;
+    --ci) seconds=30 ;;
     --seconds) seconds="$2"; shift ;;
     --jobs) jobs="$2"; shift ;;
     -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
