@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
@@ -30,6 +31,7 @@ using HostArray = std::vector<T, DefaultInitAllocator<T>>;
 struct Scratch {
   HostArray<Ray> rays;
   HostArray<Hit> hits;
+  HostArray<std::uint32_t> ids;  // rtcl::Scene's instance ids of the hits
   HostArray<float> xyz;
   HostArray<PointHit> point_hits;
 
