@@ -160,6 +160,7 @@ py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthread
       });
     } else if (b->flat) {
       const FlatScene& flat = *b->flat;
+      const bool one_part = flat.first_prim.size() == 2;  // one mesh: no search
       ray_pipeline(
           rays, tmin, tmax,
           [&](Scratch& s, std::size_t, std::size_t n) {
@@ -177,9 +178,14 @@ py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthread
                       continue;
                     }
                     t_out[i] = h.t;
-                    std::uint32_t placement;
-                    flat.locate(h.prim, placement, p_out[i]);
-                    g_out[i] = placement;  // the flat scene's placement k is geometry k
+                    if (one_part) {
+                      g_out[i] = 0;
+                      p_out[i] = static_cast<std::uint32_t>(h.prim);
+                    } else {
+                      std::uint32_t placement;
+                      flat.locate(h.prim, placement, p_out[i]);
+                      g_out[i] = placement;  // the flat scene's placement k is geometry k
+                    }
                     if (i_out) i_out[i] = kInvalidId;
                     uv_out[2 * i] = h.u;
                     uv_out[2 * i + 1] = h.v;
