@@ -121,6 +121,54 @@ void point_pipeline(const FloatRecords& points, Run&& run, Unpack&& unpack) {
 
 constexpr auto kNothing = [](Scratch&, std::size_t, std::size_t, bool) {};
 
+// The output arrays of cast_rays (instance: null when not returned).
+struct RayAnswers {
+  float* t;
+  std::uint32_t* geometry;
+  std::uint32_t* primitive;
+  std::uint32_t* instance;
+  float* uv;
+  float* normal;
+};
+
+// Writes the answers of hits[0, n) of a flat scene to rays [first, first +
+// n): one pass over the hits, each output written in order. `one_part`: the
+// scene has one mesh (no search for the part).
+void write_flat(const FlatScene& flat, bool one_part, const Hit* __restrict hits, std::size_t n, std::size_t first,
+                const RayAnswers& out) {
+  float* __restrict t = out.t + first;
+  std::uint32_t* __restrict g = out.geometry + first;
+  std::uint32_t* __restrict p = out.primitive + first;
+  std::uint32_t* __restrict id = out.instance ? out.instance + first : nullptr;
+  float* __restrict uv = out.uv + 2 * first;
+  float* __restrict nrm = out.normal + 3 * first;
+  const glm::vec3* __restrict normals = flat.normals.data();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Hit h = hits[k];
+    if (id) id[k] = kInvalidId;
+    if (h.prim < 0) {
+      t[k] = kInf;
+      g[k] = p[k] = kInvalidId;
+      uv[2 * k] = uv[2 * k + 1] = 0.0f;
+      nrm[3 * k] = nrm[3 * k + 1] = nrm[3 * k + 2] = 0.0f;
+      continue;
+    }
+    t[k] = h.t;
+    if (one_part) {
+      g[k] = 0;
+      p[k] = static_cast<std::uint32_t>(h.prim);
+    } else {
+      flat.locate(h.prim, g[k], p[k]);  // the flat scene's placement k is geometry k
+    }
+    uv[2 * k] = h.u;
+    uv[2 * k + 1] = h.v;
+    const glm::vec3 normal = normals[h.prim];
+    nrm[3 * k] = normal.x;
+    nrm[3 * k + 1] = normal.y;
+    nrm[3 * k + 2] = normal.z;
+  }
+}
+
 py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthreads, double tnear, double tfar,
                    bool coherent) {
   const char* call = "cast_rays";
@@ -167,33 +215,11 @@ py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthread
             flat.accel->trace(Query::closest, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
           },
           [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
+            const RayAnswers out{t_out, g_out, p_out, i_out, uv_out, n_out};
             for_parts(
                 n,
                 [&](std::size_t begin, std::size_t end) {
-                  for (std::size_t k = begin; k < end; ++k) {
-                    const std::size_t i = first + k;
-                    const Hit& h = s.hits[k];
-                    if (h.prim < 0) {
-                      miss(i);
-                      continue;
-                    }
-                    t_out[i] = h.t;
-                    if (one_part) {
-                      g_out[i] = 0;
-                      p_out[i] = static_cast<std::uint32_t>(h.prim);
-                    } else {
-                      std::uint32_t placement;
-                      flat.locate(h.prim, placement, p_out[i]);
-                      g_out[i] = placement;  // the flat scene's placement k is geometry k
-                    }
-                    if (i_out) i_out[i] = kInvalidId;
-                    uv_out[2 * i] = h.u;
-                    uv_out[2 * i + 1] = h.v;
-                    const glm::vec3& normal = flat.normals[static_cast<std::size_t>(h.prim)];
-                    n_out[3 * i] = normal.x;
-                    n_out[3 * i + 1] = normal.y;
-                    n_out[3 * i + 2] = normal.z;
-                  }
+                  write_flat(flat, one_part, s.hits.data() + begin, end - begin, first + begin, out);
                 },
                 parallel);
           });
