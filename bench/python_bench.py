@@ -7,8 +7,9 @@ primary rays (bench/support/scene_catalog.cpp, ray_sets.cpp) and, from
 their hits, one shadow ray towards the scene's light and one diffuse ray
 each, built here as ray_sets.cpp builds them. Timed in Python, numpy
 conversion included (median of --repeat calls after one warm-up call):
-cast_rays (camera rays: plain and coherent=True; diffuse rays) and
-test_occlusions (shadow rays). From the same session:
+cast_rays (camera rays: plain, coherent=True, and in a scene with an
+instance, which traces two levels; diffuse rays) and test_occlusions
+(shadow rays). From the same session:
   - rtcl_query_bench (the C++ host-array path, Accel::trace on Ray records,
     and Embree's rtcIntersect1 on 2 threads, same camera rays);
   - `rtcl bench --accel bvh` (Embree's rtcIntersect1 / rtcOccluded1 on the
@@ -231,9 +232,17 @@ def main():
         hits = scene.cast_rays(camera_rays)  # builds the structure
         shadow, diffuse = secondary_rays(v, f, camera_rays, hits, light)
         mrays = lambda count, ms: count / (ms * 1e3)
+        # The same mesh in a scene with instances: the mesh where its
+        # vertices are and one copy out of view, traced through two levels.
+        instanced = rtcl.RaycastingScene()
+        instanced.add_triangles(v, f)
+        away = np.eye(4)
+        away[:3, 3] = 100.0 * (v.max(axis=0) - v.min(axis=0))
+        instanced.add_instance(0, away)
         python_rates[name] = {
             "primary": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays), args.repeat)),
             "primary coherent": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays, coherent=True), args.repeat)),
+            "primary instanced": mrays(n, median_ms(lambda: instanced.cast_rays(camera_rays), args.repeat)),
             "shadow": mrays(len(shadow), median_ms(lambda: scene.test_occlusions(shadow, 0.0, 1.0), args.repeat)),
             "diffuse": mrays(len(diffuse), median_ms(lambda: scene.cast_rays(diffuse), args.repeat)),
         }
