@@ -322,3 +322,19 @@ def test_edits_and_queries_from_several_threads():
         t.join()
     assert not errors, errors[0]
     assert seen <= {4.0, 14.0} and seen
+
+
+def test_a_mesh_with_nothing_to_hit_gains_area():
+    """A mesh of one zero-area triangle, placed twice, is never hit; moved by
+    update_vertices to a real triangle, both placements are."""
+    flat = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0]], np.float32)
+    scene = rtcl.RaycastingScene()
+    g = scene.add_triangles(flat, np.array([[0, 1, 2]], np.uint32))
+    assert scene.add_instance(g, affine(np.eye(3), (0.0, 0.0, -10.0))) == 0
+    rays = np.array([[0.2, 0.2, 5, 0, 0, -1], [0.2, 0.2, -5, 0, 0, -1]], np.float32)
+    assert scene.cast_rays(rays)["t_hit"].tolist() == [np.inf, np.inf]
+    scene.update_vertices(g, np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32))
+    ans = scene.cast_rays(rays)
+    assert np.allclose(ans["t_hit"], [5.0, 5.0], rtol=0, atol=1e-5)
+    assert ans["instance_ids"].tolist() == [INVALID, 0]
+    assert np.allclose(ans["primitive_normals"], [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]], atol=1e-6)
