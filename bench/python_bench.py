@@ -7,8 +7,9 @@ primary rays (bench/support/scene_catalog.cpp, ray_sets.cpp) and, from
 their hits, one shadow ray towards the scene's light and one diffuse ray
 each, built here as ray_sets.cpp builds them. Timed in Python, numpy
 conversion included (median of --repeat calls after one warm-up call):
-cast_rays (camera rays: plain and coherent=True; diffuse rays) and
-test_occlusions (shadow rays). From the same session:
+cast_rays (camera rays: plain, coherent=True, and in a scene with an
+instance, which traces two levels; diffuse rays) and test_occlusions
+(shadow rays). From the same session:
   - rtcl_query_bench (the C++ host-array path, Accel::trace on Ray records,
     and Embree's rtcIntersect1 on 2 threads, same camera rays);
   - `rtcl bench --accel bvh` (Embree's rtcIntersect1 / rtcOccluded1 on the
@@ -20,10 +21,12 @@ queries work), interleaved call by call; compute_signed_distance and
 compute_occupancy beside them.
 
   /usr/bin/python3 bench/python_bench.py [--build build] [--scene bunny,dragon,sponza]
-      [--size 1024] [--repeat 5] [--points 1000000] [--no-cpp] [--no-open3d] [--json FILE]
+      [--size 1024] [--repeat 5] [--rounds 1] [--points 1000000] [--no-cpp] [--no-open3d] [--json FILE]
 
 Run it on a quiet machine: it reports rates, and other work on the cores
-changes them. The module is imported from BUILD/python unless PYTHONPATH
+changes them. On a shared one, --rounds N takes the Python timings and
+rtcl_query_bench's N times in turn and reports the median of the rounds'
+Python / C++ ratios. The module is imported from BUILD/python unless PYTHONPATH
 already finds one.
 """
 import argparse
@@ -203,6 +206,8 @@ def main():
     parser.add_argument("--scene", default="bunny,dragon,sponza")
     parser.add_argument("--size", type=int, default=1024, help="camera rays: size x size")
     parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--rounds", type=int, default=1,
+                        help="Python timings and rtcl_query_bench's taken this many times in turn")
     parser.add_argument("--points", type=int, default=1_000_000)
     parser.add_argument("--no-cpp", action="store_true", help="leave out rtcl_query_bench and rtcl bench")
     parser.add_argument("--no-open3d", action="store_true")
@@ -221,7 +226,7 @@ def main():
     print(f"device: {device}; {args.size} x {args.size} camera rays per scene; medians of {args.repeat} calls\n")
     results = {"device": device, "size": args.size, "repeat": args.repeat, "rays": {}, "points": {}}
 
-    python_rates = {}
+    prepared = {}
     for name in scenes:
         file, camera, light = SCENES[name]
         v, f = load_obj(Path(args.scenes_dir) / file)
@@ -230,30 +235,64 @@ def main():
         camera_rays = primary_rays(camera, args.size)
         hits = scene.cast_rays(camera_rays)  # builds the structure
         shadow, diffuse = secondary_rays(v, f, camera_rays, hits, light)
-        mrays = lambda count, ms: count / (ms * 1e3)
-        python_rates[name] = {
-            "primary": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays), args.repeat)),
-            "primary coherent": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays, coherent=True), args.repeat)),
-            "shadow": mrays(len(shadow), median_ms(lambda: scene.test_occlusions(shadow, 0.0, 1.0), args.repeat)),
-            "diffuse": mrays(len(diffuse), median_ms(lambda: scene.cast_rays(diffuse), args.repeat)),
-        }
+        # The same mesh in a scene with instances: the mesh where its
+        # vertices are and one copy out of view, traced through two levels.
+        instanced = rtcl.RaycastingScene()
+        instanced.add_triangles(v, f)
+        away = np.eye(4)
+        away[:3, 3] = 100.0 * (v.max(axis=0) - v.min(axis=0))
+        instanced.add_instance(0, away)
+        prepared[name] = (scene, instanced, camera_rays, shadow, diffuse)
         print(f"{name}: {len(f)} triangles, {len(shadow)} shadow and diffuse rays", flush=True)
-    cpp = {} if args.no_cpp else query_bench(build, scenes, args.size, args.repeat)
+
+    # Rounds of the Python timings, each followed by rtcl_query_bench's, so
+    # that each Python / C++ ratio compares timings taken close together
+    # (on a shared machine the load changes within minutes).
+    mrays = lambda count, ms: count / (ms * 1e3)
+    rounds = []
+    for _ in range(args.rounds):
+        python_rates = {}
+        for name, (scene, instanced, camera_rays, shadow, diffuse) in prepared.items():
+            python_rates[name] = {
+                "primary": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays), args.repeat)),
+                "primary coherent": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays, coherent=True),
+                                                       args.repeat)),
+                "primary instanced": mrays(n, median_ms(lambda: instanced.cast_rays(camera_rays), args.repeat)),
+                "shadow": mrays(len(shadow), median_ms(lambda: scene.test_occlusions(shadow, 0.0, 1.0), args.repeat)),
+                "diffuse": mrays(len(diffuse), median_ms(lambda: scene.cast_rays(diffuse), args.repeat)),
+            }
+        cpp = {} if args.no_cpp else query_bench(build, scenes, args.size, args.repeat)
+        rounds.append((python_rates, cpp))
     embree = {} if args.no_cpp else rtcl_bench(build, scenes, args.size, args.repeat, args.scenes_dir)
+    median = lambda xs: float(np.median(xs)) if xs else None
+    python_rates = {name: {rays: median([r[0][name][rays] for r in rounds]) for rays in rounds[0][0][name]}
+                    for name in scenes}
+    hosts = {name: [r[1][name]["host"] for r in rounds if r[1].get(name, {}).get("host")] for name in scenes}
+    if args.rounds > 1:
+        print(f"\n{args.rounds} rounds: rates are medians over the rounds, Python/C++ the median of each "
+              "round's ratio")
 
     print("\n| scene | rays | Python Mrays/s | C++ host arrays | Python/C++ | Embree (2 threads) | Python/Embree |")
     print("|---|---|---|---|---|---|---|")
     for name in scenes:
         for rays, rate in python_rates[name].items():
             kind = rays.split()[0]
-            host = cpp.get(name, {}).get("host") if kind == "primary" else None
+            host = median(hosts[name]) if kind == "primary" else None
+            ratio = median([r[0][name][rays] / r[1][name]["host"] for r in rounds
+                            if r[1].get(name, {}).get("host")]) if host else None
             base = embree.get((name, kind))
             cells = [name, rays + (" (test_occlusions)" if kind == "shadow" else " (cast_rays)"), f"{rate:.2f}",
-                     f"{host:.2f}" if host else "-", f"{rate / host:.2f}" if host else "-",
+                     f"{host:.2f}" if host else "-", f"{ratio:.2f}" if host else "-",
                      f"{base[2]:.2f} {base[0]}" if base else "-", f"{rate / base[2]:.2f}" if base else "-"]
             print("| " + " | ".join(cells) + " |")
             results["rays"][f"{name} {rays}"] = {"python": rate, "cpp_host": host,
                                                  "embree": base[2] if base else None}
+
+    if args.rounds > 1 and not args.no_cpp:
+        for name in scenes:
+            each = [r[0][name]["primary"] / r[1][name]["host"] for r in rounds if r[1].get(name, {}).get("host")]
+            print(f"{name} primary Python/C++ by round: " + ", ".join(f"{x:.2f}" for x in each))
+            results["rays"][f"{name} primary"]["ratio_by_round"] = each
 
     # Point queries on the bunny.
     v, f = load_obj(Path(args.scenes_dir) / SCENES["bunny"][0])

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <string>
 
@@ -130,17 +131,64 @@ std::size_t first_bad_point(const FloatRecords& r) {
 
 }  // namespace
 
+namespace {
+
+// Large output blocks that arrays gave back, kept for the next arrays of the
+// same size: a block used before costs no page faults (and no zeroing by
+// the kernel) when the next call writes it. At most kKeptBytes are kept;
+// a block beyond goes back to the system.
+constexpr std::size_t kHugePage = std::size_t{2} << 20;
+constexpr std::size_t kKeptBytes = std::size_t{512} << 20;
+
+struct KeptBlocks {
+  std::mutex mutex;
+  std::multimap<std::size_t, void*> blocks;  // by rounded size
+  std::size_t bytes = 0;
+};
+KeptBlocks& kept() {
+  static auto* k = new KeptBlocks();  // never destroyed, as the scratch pool
+  return *k;
+}
+
+std::size_t rounded(std::size_t bytes) { return (bytes + kHugePage - 1) / kHugePage * kHugePage; }
+
+}  // namespace
+
 void* output_memory(std::size_t bytes) {
-  constexpr std::size_t huge = std::size_t{2} << 20;
   void* p = nullptr;
   if (bytes >= kHugePageAdviceBytes) {
-    p = std::aligned_alloc(huge, (bytes + huge - 1) / huge * huge);
+    const std::size_t size = rounded(bytes);
+    {
+      KeptBlocks& k = kept();
+      std::lock_guard lock(k.mutex);
+      if (auto found = k.blocks.find(size); found != k.blocks.end()) {
+        p = found->second;
+        k.blocks.erase(found);
+        k.bytes -= size;
+        return p;
+      }
+    }
+    p = std::aligned_alloc(kHugePage, size);
     if (p) advise_huge_pages(p, bytes);
   } else {
     p = std::malloc(std::max<std::size_t>(bytes, 1));
   }
   if (!p) throw std::bad_alloc();
   return p;
+}
+
+void release_output_memory(void* p, std::size_t bytes) {
+  if (bytes >= kHugePageAdviceBytes) {
+    const std::size_t size = rounded(bytes);
+    KeptBlocks& k = kept();
+    std::lock_guard lock(k.mutex);
+    if (k.bytes + size <= kKeptBytes) {
+      k.blocks.emplace(size, p);
+      k.bytes += size;
+      return;
+    }
+  }
+  std::free(p);
 }
 
 std::string shape_text(const std::vector<py::ssize_t>& shape) {
@@ -247,6 +295,38 @@ std::vector<glm::uvec3> read_triangles(py::handle object, const char* call, cons
     }
   }
   return out;
+}
+
+}  // namespace rtcl::python
+
+namespace rtcl::python {
+
+Transform read_transform(py::handle object, const char* call, const char* param) {
+  const FloatRecords r = float_records(object, 4, call, param, true);
+  if (r.count != 3 && r.count != 4)
+    throw py::value_error(std::string(call) + ": " + param + " has shape (" + std::to_string(r.count) +
+                          ", 4); expected (4, 4) or (3, 4)");
+  double m[4][4];
+  const py::ssize_t s = r.value_stride;
+  walk(r, 0, r.count, [&](std::size_t row, const char* p) {
+    for (int col = 0; col < 4; ++col) m[row][col] = r.float64 ? value<double>(p, s, col) : value<float>(p, s, col);
+  });
+  Transform t;
+  for (std::size_t row = 0; row < r.count; ++row)
+    for (int col = 0; col < 4; ++col) {
+      const double x = m[row][col];
+      const bool fits = row == 3 || std::abs(x) <= static_cast<double>(std::numeric_limits<float>::max());
+      if (!std::isfinite(x) || !fits)
+        throw py::value_error(std::string(call) + ": " + param + "[" + std::to_string(row) + ", " +
+                              std::to_string(col) + "] is " + py::repr(py::float_(x)).cast<std::string>() +
+                              "; must be finite (within float's range)");
+      if (row < 3) t.m[row][col] = static_cast<float>(x);
+    }
+  if (r.count == 4 && !(m[3][0] == 0.0 && m[3][1] == 0.0 && m[3][2] == 0.0 && m[3][3] == 1.0))
+    throw py::value_error(std::string(call) + ": " + param + " has last row " +
+                          py::repr(py::make_tuple(m[3][0], m[3][1], m[3][2], m[3][3])).cast<std::string>() +
+                          "; an affine transform's is (0, 0, 0, 1)");
+  return t;
 }
 
 }  // namespace rtcl::python

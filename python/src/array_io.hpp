@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "rtcl/queries.hpp"
+#include "rtcl/scene.hpp"
 
 namespace rtcl::python {
 
@@ -67,22 +68,39 @@ void pack_points(const FloatRecords& points, std::size_t first, std::span<float>
 std::vector<glm::vec3> read_vertices(py::handle object, const char* call, const char* param);
 std::vector<glm::uvec3> read_triangles(py::handle object, const char* call, const char* param);
 
-// Memory for an output array of `bytes`, released by free(): from 4 MiB up
-// aligned to 2 MiB and advised for huge pages, so that its first touch
-// (while the answers are written) costs one page fault per 2 MiB, not per
-// 4 KiB (rtcl/huge_pages.hpp). Throws std::bad_alloc.
+// An affine transform, (4, 4) with last row (0, 0, 0, 1) or (3, 4), float32
+// or float64 (TypeError otherwise), rows as rtcl::Transform's: ValueError
+// naming PARAM's element for a non-finite value (or one beyond float's
+// range) or the last row. Singular transforms are the caller's check.
+Transform read_transform(py::handle object, const char* call, const char* param);
+
+// Memory for an output array of `bytes`, given back by
+// release_output_memory(p, bytes): from 4 MiB up aligned to 2 MiB and
+// advised for huge pages, so that its first touch (while the answers are
+// written) costs one page fault per 2 MiB, not per 4 KiB
+// (rtcl/huge_pages.hpp); such blocks, once given back, are kept (up to
+// 512 MiB) for the next arrays of the same size, which then cost no page
+// faults at all. Throws std::bad_alloc.
 void* output_memory(std::size_t bytes);
+void release_output_memory(void* p, std::size_t bytes);
 
 // A fresh C-contiguous output array of shape leading + trailing, its memory
-// from output_memory (owned by the array).
+// from output_memory (owned by the array, given back when numpy frees it).
 template <class T>
 py::array_t<T> output_array(const std::vector<py::ssize_t>& leading, std::initializer_list<py::ssize_t> trailing = {}) {
   std::vector<py::ssize_t> shape = leading;
   shape.insert(shape.end(), trailing.begin(), trailing.end());
   std::size_t count = 1;
   for (py::ssize_t n : shape) count *= static_cast<std::size_t>(n);
-  void* memory = output_memory(count * sizeof(T));
-  py::capsule owner(memory, [](void* p) { std::free(p); });
+  const std::size_t bytes = count * sizeof(T);
+  void* memory = output_memory(bytes);
+  // The capsule's context carries the size for the release.
+  py::capsule owner(memory, nullptr, [](PyObject* o) {
+    void* p = PyCapsule_GetPointer(o, nullptr);
+    const auto size = reinterpret_cast<std::uintptr_t>(PyCapsule_GetContext(o));
+    release_output_memory(p, static_cast<std::size_t>(size));
+  });
+  PyCapsule_SetContext(owner.ptr(), reinterpret_cast<void*>(static_cast<std::uintptr_t>(bytes)));
   return py::array_t<T>(shape, static_cast<T*>(memory), owner);
 }
 

@@ -43,15 +43,43 @@ unsigned check_nsamples(long long nsamples, const char* call) {
   return static_cast<unsigned>(nsamples);
 }
 
+// An id argument as uint32: ValueError naming it when negative or beyond.
+std::uint32_t check_id(long long id, const char* call, const char* param) {
+  if (id < 0 || id >= 0xffffffffll)
+    throw py::value_error(std::string(call) + ": " + param + " is " + std::to_string(id) + "; no such id");
+  return static_cast<std::uint32_t>(id);
+}
+
 Coherence coherence_of(bool coherent) { return coherent ? Coherence::coherent : Coherence::incoherent; }
 
-// The structure over the scene's meshes as they are now, or null when there
-// is nothing to query (no ray or point, or nothing to hit): the caller then
-// writes misses.
-const Accel* structure(const MeshScene& scene, std::size_t count, std::shared_ptr<const BuiltScene>& built) {
+// The scene as it is now, or nothing (an empty view) when there is no ray
+// or point to query.
+SceneView view_of(const MeshScene& scene, std::size_t count) {
+  if (count == 0) return {};
+  return scene.snapshot();
+}
+
+// The flat structure that count_intersections, list_intersections and the
+// point queries run on (the instanced scene's flattened copy, made from the
+// snapshot alone: the rtcl::Scene's commit is not held), or null when there
+// is nothing to query or to hit. `built` and `flat` keep them.
+const Accel* flat_structure(const MeshScene& scene, std::size_t count, std::shared_ptr<const BuiltScene>& built,
+                            std::shared_ptr<const FlatScene>& flat) {
   if (count == 0) return nullptr;
-  built = scene.snapshot();
-  return built->accel.get();
+  built = scene.snapshot().built;
+  if (!built->hittable) return nullptr;
+  flat = built->flattened(scene.device(), scene.accel_spec(), scene.config());
+  return flat->accel.get();
+}
+
+// Writes the face normal of triangle `prim` of placement `p` to out[0..2]:
+// the unit (v1 - v0) x (v2 - v0) of the placed triangle.
+inline void placed_normal(const BuiltScene& b, const Placement& p, std::uint32_t prim, float* out) {
+  glm::vec3 n = b.meshes[p.geometry]->normals[prim];
+  if (!p.identity) n = glm::normalize(p.cofactor * n);
+  out[0] = n.x;
+  out[1] = n.y;
+  out[2] = n.z;
 }
 
 // Two sets of scratch arrays for pipeline()'s slots.
@@ -93,59 +121,136 @@ void point_pipeline(const FloatRecords& points, Run&& run, Unpack&& unpack) {
 
 constexpr auto kNothing = [](Scratch&, std::size_t, std::size_t, bool) {};
 
+// The output arrays of cast_rays (instance: null when not returned).
+struct RayAnswers {
+  float* t;
+  std::uint32_t* geometry;
+  std::uint32_t* primitive;
+  std::uint32_t* instance;
+  float* uv;
+  float* normal;
+};
+
+// Writes the answers of hits[0, n) of a flat scene to rays [first, first +
+// n): one pass over the hits, each output written in order. `one_part`: the
+// scene has one mesh (no search for the part).
+void write_flat(const FlatScene& flat, bool one_part, const Hit* __restrict hits, std::size_t n, std::size_t first,
+                const RayAnswers& out) {
+  float* __restrict t = out.t + first;
+  std::uint32_t* __restrict g = out.geometry + first;
+  std::uint32_t* __restrict p = out.primitive + first;
+  std::uint32_t* __restrict id = out.instance ? out.instance + first : nullptr;
+  float* __restrict uv = out.uv + 2 * first;
+  float* __restrict nrm = out.normal + 3 * first;
+  const glm::vec3* __restrict normals = flat.normals.data();
+  for (std::size_t k = 0; k < n; ++k) {
+    const Hit h = hits[k];
+    if (id) id[k] = kInvalidId;
+    if (h.prim < 0) {
+      t[k] = kInf;
+      g[k] = p[k] = kInvalidId;
+      uv[2 * k] = uv[2 * k + 1] = 0.0f;
+      nrm[3 * k] = nrm[3 * k + 1] = nrm[3 * k + 2] = 0.0f;
+      continue;
+    }
+    t[k] = h.t;
+    if (one_part) {
+      g[k] = 0;
+      p[k] = static_cast<std::uint32_t>(h.prim);
+    } else {
+      flat.locate(h.prim, g[k], p[k]);  // the flat scene's placement k is geometry k
+    }
+    uv[2 * k] = h.u;
+    uv[2 * k + 1] = h.v;
+    const glm::vec3 normal = normals[h.prim];
+    nrm[3 * k] = normal.x;
+    nrm[3 * k + 1] = normal.y;
+    nrm[3 * k + 2] = normal.z;
+  }
+}
+
 py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthreads, double tnear, double tfar,
                    bool coherent) {
   const char* call = "cast_rays";
   check_nthreads(nthreads, call);
   const FloatRecords rays = float_records(rays_in, 6, call, "rays");
   const float tmin = ray_bound(tnear, call, "tnear"), tmax = ray_bound(tfar, call, "tfar");
+  // Instanced scenes never become flat again: a scene instanced now is
+  // instanced at the snapshot below.
+  const bool with_instances = scene.instanced();
   auto t_hit = output_array<float>(rays.shape);
   auto geometry_ids = output_array<std::uint32_t>(rays.shape);
   auto primitive_ids = output_array<std::uint32_t>(rays.shape);
   auto uvs = output_array<float>(rays.shape, {2});
   auto normals = output_array<float>(rays.shape, {3});
+  py::array_t<std::uint32_t> instance_ids;
+  if (with_instances) instance_ids = output_array<std::uint32_t>(rays.shape);
   float* t_out = t_hit.mutable_data();
   std::uint32_t* g_out = geometry_ids.mutable_data();
   std::uint32_t* p_out = primitive_ids.mutable_data();
   float* uv_out = uvs.mutable_data();
   float* n_out = normals.mutable_data();
+  std::uint32_t* i_out = with_instances ? instance_ids.mutable_data() : nullptr;
   {
     py::gil_scoped_release release;
-    std::shared_ptr<const BuiltScene> built;
-    const Accel* accel = structure(scene, rays.count, built);
-    // Ray i's answers from its hit (null: a miss).
-    auto write = [&](std::size_t i, const Hit* h) {
-      if (!h || h->prim < 0) {
-        t_out[i] = kInf;
-        g_out[i] = p_out[i] = kInvalidId;
-        uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
-        n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
-        return;
-      }
-      t_out[i] = h->t;
-      built->locate(h->prim, g_out[i], p_out[i]);
-      uv_out[2 * i] = h->u;
-      uv_out[2 * i + 1] = h->v;
-      const glm::vec3& normal = built->normals[static_cast<std::size_t>(h->prim)];
-      n_out[3 * i] = normal.x;
-      n_out[3 * i + 1] = normal.y;
-      n_out[3 * i + 2] = normal.z;
+    const SceneView view = view_of(scene, rays.count);
+    const BuiltScene* b = view.built.get();
+    auto miss = [&](std::size_t i) {
+      t_out[i] = kInf;
+      g_out[i] = p_out[i] = kInvalidId;
+      if (i_out) i_out[i] = kInvalidId;
+      uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
+      n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
     };
-    if (!accel) {
+    if (!b || !b->hittable) {
       for_parts(rays.count, [&](std::size_t begin, std::size_t end) {
-        for (std::size_t i = begin; i < end; ++i) write(i, nullptr);
+        for (std::size_t i = begin; i < end; ++i) miss(i);
       });
+    } else if (b->flat) {
+      const FlatScene& flat = *b->flat;
+      const bool one_part = flat.first_prim.size() == 2;  // one mesh: no search
+      ray_pipeline(
+          rays, tmin, tmax,
+          [&](Scratch& s, std::size_t, std::size_t n) {
+            flat.accel->trace(Query::closest, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
+          },
+          [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
+            const RayAnswers out{t_out, g_out, p_out, i_out, uv_out, n_out};
+            for_parts(
+                n,
+                [&](std::size_t begin, std::size_t end) {
+                  write_flat(flat, one_part, s.hits.data() + begin, end - begin, first + begin, out);
+                },
+                parallel);
+          });
     } else {
       ray_pipeline(
           rays, tmin, tmax,
           [&](Scratch& s, std::size_t, std::size_t n) {
-            accel->trace(Query::closest, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
+            b->scene->trace(Query::closest, records(s, n), Scratch::first(s.hits, n), Scratch::first(s.ids, n), {},
+                            coherence_of(coherent));
           },
           [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
             for_parts(
                 n,
                 [&](std::size_t begin, std::size_t end) {
-                  for (std::size_t k = begin; k < end; ++k) write(first + k, &s.hits[k]);
+                  for (std::size_t k = begin; k < end; ++k) {
+                    const std::size_t i = first + k;
+                    const Hit& h = s.hits[k];
+                    if (h.prim < 0) {
+                      miss(i);
+                      continue;
+                    }
+                    // The scene's user id of an instance is its placement.
+                    const Placement& p = b->placements[s.ids[k]];
+                    t_out[i] = h.t;
+                    g_out[i] = p.geometry;
+                    p_out[i] = static_cast<std::uint32_t>(h.prim);
+                    if (i_out) i_out[i] = p.instance;
+                    uv_out[2 * i] = h.u;
+                    uv_out[2 * i + 1] = h.v;
+                    placed_normal(*b, p, static_cast<std::uint32_t>(h.prim), n_out + 3 * i);
+                  }
                 },
                 parallel);
           });
@@ -157,6 +262,7 @@ py::dict cast_rays(const MeshScene& scene, py::handle rays_in, long long nthread
   out["primitive_ids"] = primitive_ids;
   out["primitive_uvs"] = uvs;
   out["primitive_normals"] = normals;
+  if (with_instances) out["instance_ids"] = instance_ids;
   return out;
 }
 
@@ -170,15 +276,18 @@ py::array test_occlusions(const MeshScene& scene, py::handle rays_in, double tne
   bool* out = occluded.mutable_data();
   {
     py::gil_scoped_release release;
-    std::shared_ptr<const BuiltScene> built;
-    const Accel* accel = structure(scene, rays.count, built);
-    if (!accel) {
+    const SceneView view = view_of(scene, rays.count);
+    const BuiltScene* b = view.built.get();
+    if (!b || !b->hittable) {
       std::fill(out, out + rays.count, false);
     } else {
       ray_pipeline(
           rays, tmin, tmax,
           [&](Scratch& s, std::size_t, std::size_t n) {
-            accel->trace(Query::any, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
+            if (b->flat)
+              b->flat->accel->trace(Query::any, records(s, n), Scratch::first(s.hits, n), coherence_of(coherent));
+            else
+              b->scene->trace(Query::any, records(s, n), Scratch::first(s.hits, n), {}, {}, coherence_of(coherent));
           },
           [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
             for_parts(
@@ -202,7 +311,8 @@ py::array count_intersections(const MeshScene& scene, py::handle rays_in, long l
   {
     py::gil_scoped_release release;
     std::shared_ptr<const BuiltScene> built;
-    const Accel* accel = structure(scene, rays.count, built);
+    std::shared_ptr<const FlatScene> flat;
+    const Accel* accel = flat_structure(scene, rays.count, built, flat);
     if (!accel) {
       std::fill(out, out + rays.count, 0);
     } else {
@@ -227,9 +337,10 @@ py::dict list_intersections(const MeshScene& scene, py::handle rays_in, long lon
   // One library call for all rays (its answer is one compressed list).
   AllHits all;
   std::shared_ptr<const BuiltScene> built;
+  std::shared_ptr<const FlatScene> flat;
   {
     py::gil_scoped_release release;
-    if (const Accel* accel = structure(scene, rays.count, built)) {
+    if (const Accel* accel = flat_structure(scene, rays.count, built, flat)) {
       HostArray<Ray> packed(rays.count);
       pack_rays(rays, 0, 0.0f, kInf, packed);
       all = accel->all_hits(Rays(std::span<const Ray>(packed)));
@@ -246,6 +357,10 @@ py::dict list_intersections(const MeshScene& scene, py::handle rays_in, long lon
   auto geometry_ids = output_array<std::uint32_t>({k});
   auto primitive_ids = output_array<std::uint32_t>({k});
   auto uvs = output_array<float>({k}, {2});
+  const bool with_instances = scene.instanced();
+  py::array_t<std::uint32_t> instance_ids;
+  if (with_instances) instance_ids = output_array<std::uint32_t>({k});
+  std::uint32_t* i_out = with_instances ? instance_ids.mutable_data() : nullptr;
   std::uint32_t* splits = ray_splits.mutable_data();
   std::uint32_t* ids = ray_ids.mutable_data();
   float* t_out = t_hit.mutable_data();
@@ -264,7 +379,11 @@ py::dict list_intersections(const MeshScene& scene, py::handle rays_in, long lon
           const Hit& h = all.hits[j];
           ids[j] = static_cast<std::uint32_t>(r);
           t_out[j] = h.t;
-          built->locate(h.prim, g_out[j], p_out[j]);
+          std::uint32_t placement;
+          flat->locate(h.prim, placement, p_out[j]);
+          const Placement& p = built->placements[placement];
+          g_out[j] = p.geometry;
+          if (i_out) i_out[j] = p.instance;
           uv_out[2 * j] = h.u;
           uv_out[2 * j + 1] = h.v;
         }
@@ -278,19 +397,21 @@ py::dict list_intersections(const MeshScene& scene, py::handle rays_in, long lon
   out["geometry_ids"] = geometry_ids;
   out["primitive_ids"] = primitive_ids;
   out["primitive_uvs"] = uvs;
+  if (with_instances) out["instance_ids"] = instance_ids;
   return out;
 }
 
 // compute_closest_points and compute_distance: the library's closest
-// points chunk by chunk, then write(built, first, n, hits, parallel); hits
-// is empty when the scene has nothing to hit.
+// points chunk by chunk, then write(built, flat, first, n, hits, parallel);
+// hits is empty when the scene has nothing to hit.
 template <class Write>
 void closest_points(const MeshScene& scene, const FloatRecords& points, const char* call, Write&& write) {
   check_points(points, call, "query_points");  // NaN and infinite points are refused, scene or not
   std::shared_ptr<const BuiltScene> built;
-  const Accel* accel = structure(scene, points.count, built);
+  std::shared_ptr<const FlatScene> flat;
+  const Accel* accel = flat_structure(scene, points.count, built, flat);
   if (!accel) {
-    write(built.get(), 0, points.count, std::span<const PointHit>(), true);
+    write(built.get(), flat.get(), 0, points.count, std::span<const PointHit>(), true);
     return;
   }
   point_pipeline(
@@ -299,7 +420,7 @@ void closest_points(const MeshScene& scene, const FloatRecords& points, const ch
         accel->closest_points(points_of(s, n), Scratch::first(s.point_hits, n));
       },
       [&](Scratch& s, std::size_t first, std::size_t n, bool parallel) {
-        write(built.get(), first, n, std::span<const PointHit>(s.point_hits.data(), n), parallel);
+        write(built.get(), flat.get(), first, n, std::span<const PointHit>(s.point_hits.data(), n), parallel);
       });
 }
 
@@ -312,6 +433,10 @@ py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, lo
   auto primitive_ids = output_array<std::uint32_t>(points.shape);
   auto uvs = output_array<float>(points.shape, {2});
   auto normals = output_array<float>(points.shape, {3});
+  const bool with_instances = scene.instanced();
+  py::array_t<std::uint32_t> instance_ids;
+  if (with_instances) instance_ids = output_array<std::uint32_t>(points.shape);
+  std::uint32_t* i_out = with_instances ? instance_ids.mutable_data() : nullptr;
   float* c_out = closest.mutable_data();
   std::uint32_t* g_out = geometry_ids.mutable_data();
   std::uint32_t* p_out = primitive_ids.mutable_data();
@@ -321,7 +446,8 @@ py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, lo
     py::gil_scoped_release release;
     closest_points(
         scene, points, call,
-        [&](const BuiltScene* built, std::size_t first, std::size_t n, std::span<const PointHit> hits, bool parallel) {
+        [&](const BuiltScene* built, const FlatScene* flat, std::size_t first, std::size_t n,
+            std::span<const PointHit> hits, bool parallel) {
           for_parts(
               n,
               [&](std::size_t begin, std::size_t end) {
@@ -330,6 +456,7 @@ py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, lo
                   if (hits.empty() || hits[k].prim < 0) {
                     c_out[3 * i] = c_out[3 * i + 1] = c_out[3 * i + 2] = kNaN;
                     g_out[i] = p_out[i] = kInvalidId;
+                    if (i_out) i_out[i] = kInvalidId;
                     uv_out[2 * i] = uv_out[2 * i + 1] = 0.0f;
                     n_out[3 * i] = n_out[3 * i + 1] = n_out[3 * i + 2] = 0.0f;
                     continue;
@@ -338,10 +465,14 @@ py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, lo
                   c_out[3 * i] = h.x;
                   c_out[3 * i + 1] = h.y;
                   c_out[3 * i + 2] = h.z;
-                  built->locate(h.prim, g_out[i], p_out[i]);
+                  std::uint32_t placement;
+                  flat->locate(h.prim, placement, p_out[i]);
+                  const Placement& p = built->placements[placement];
+                  g_out[i] = p.geometry;
+                  if (i_out) i_out[i] = p.instance;
                   uv_out[2 * i] = h.u;
                   uv_out[2 * i + 1] = h.v;
-                  const glm::vec3& normal = built->normals[static_cast<std::size_t>(h.prim)];
+                  const glm::vec3& normal = flat->normals[static_cast<std::size_t>(h.prim)];
                   n_out[3 * i] = normal.x;
                   n_out[3 * i + 1] = normal.y;
                   n_out[3 * i + 2] = normal.z;
@@ -356,6 +487,7 @@ py::dict compute_closest_points(const MeshScene& scene, py::handle points_in, lo
   out["primitive_ids"] = primitive_ids;
   out["primitive_uvs"] = uvs;
   out["primitive_normals"] = normals;
+  if (with_instances) out["instance_ids"] = instance_ids;
   return out;
 }
 
@@ -369,7 +501,8 @@ py::array compute_distance(const MeshScene& scene, py::handle points_in, long lo
     py::gil_scoped_release release;
     closest_points(
         scene, points, call,
-        [&](const BuiltScene*, std::size_t first, std::size_t n, std::span<const PointHit> hits, bool parallel) {
+        [&](const BuiltScene*, const FlatScene*, std::size_t first, std::size_t n, std::span<const PointHit> hits,
+            bool parallel) {
           for_parts(
               n,
               [&](std::size_t begin, std::size_t end) {
@@ -396,7 +529,8 @@ py::array inside_query(const MeshScene& scene, py::handle points_in, long long n
     py::gil_scoped_release release;
     check_points(points, call, "query_points");
     std::shared_ptr<const BuiltScene> built;
-    const Accel* accel = structure(scene, points.count, built);
+    std::shared_ptr<const FlatScene> flat;
+    const Accel* accel = flat_structure(scene, points.count, built, flat);
     if (!accel) {
       std::fill(out, out + points.count, none);
     } else {
@@ -423,6 +557,12 @@ accel: the acceleration structure, with options ("bvh", "bvh-packet",
     list_intersections and the point queries need the BVH family.
 precision: "fast", "robust" (watertight, the default) or "exact".
 nthreads: accepted as Open3D's (>= 0) and ignored: the device sets the threads.
+
+Beyond Open3D: add_instance places a geometry again under a transform,
+set_transform moves an instance, update_vertices moves a mesh's vertices
+(docs/python.md, "Instances"). count_intersections, list_intersections and
+the point queries of a scene with instances run on a copy with every
+placement's triangles transformed (memory grows with the instances).
 )doc");
   cls.def(py::init([](py::object device, const std::string& accel, const std::string& precision, long long nthreads) {
             check_nthreads(nthreads, "RaycastingScene");
@@ -460,6 +600,57 @@ nthreads: accepted as Open3D's (>= 0) and ignored: the device sets the threads.
       R"doc(Adds a triangle mesh: vertex_positions (N, 3) float32 (or float64),
 triangle_indices (M, 3) uint32 (or any integer dtype). Returns its geometry id
 (0, 1, ... in call order), which hits report in geometry_ids.)doc");
+  cls.def(
+      "add_instance",
+      [](MeshScene& scene, long long geometry_id, py::handle transform) {
+        const Transform t = read_transform(transform, "add_instance", "transform");
+        const std::uint32_t geometry = check_id(geometry_id, "add_instance", "geometry_id");
+        py::gil_scoped_release release;
+        try {
+          return scene.add_instance(geometry, t);
+        } catch (const Error& e) {
+          throw py::value_error(e.what());
+        }
+      },
+      py::arg("geometry_id"), py::arg("transform"),
+      R"doc(Adds one more placement of geometry geometry_id (add_triangles' id; the
+geometry also stays where add_triangles put it) under `transform`, an affine
+object-to-world map: (4, 4) with last row (0, 0, 0, 1), or (3, 4), float32
+or float64; mirroring and non-uniform scale allowed, singular or non-finite
+transforms refused (ValueError). Returns its instance id (0, 1, ... in call
+order), which hits report in instance_ids. Needs accel of the BVH family.)doc");
+  cls.def(
+      "set_transform",
+      [](MeshScene& scene, long long instance_id, py::handle transform) {
+        const Transform t = read_transform(transform, "set_transform", "transform");
+        const std::uint32_t instance = check_id(instance_id, "set_transform", "instance_id");
+        py::gil_scoped_release release;
+        try {
+          scene.set_transform(instance, t);
+        } catch (const Error& e) {
+          throw py::value_error(e.what());
+        }
+      },
+      py::arg("instance_id"), py::arg("transform"),
+      R"doc(A new transform (as add_instance's) for instance instance_id; queries see it
+from the next call on.)doc");
+  cls.def(
+      "update_vertices",
+      [](MeshScene& scene, long long geometry_id, py::handle vertex_positions) {
+        std::vector<glm::vec3> vertices = read_vertices(vertex_positions, "update_vertices", "vertex_positions");
+        const std::uint32_t geometry = check_id(geometry_id, "update_vertices", "geometry_id");
+        py::gil_scoped_release release;
+        try {
+          scene.update_vertices(geometry, std::move(vertices));
+        } catch (const Error& e) {
+          throw py::value_error(e.what());
+        }
+      },
+      py::arg("geometry_id"), py::arg("vertex_positions"),
+      R"doc(New positions (N, 3) float32 or float64 for the vertices of geometry
+geometry_id (N: its vertex count; the triangles stay), seen by every
+placement of it from the next query on, which refits its structure. Needs
+accel of the BVH family.)doc");
   cls.def("cast_rays", &cast_rays, py::arg("rays"), py::arg("nthreads") = 0, py::kw_only(), py::arg("tnear") = 0.0,
           py::arg("tfar") = std::numeric_limits<double>::infinity(), py::arg("coherent") = false,
           R"doc(The closest hit of each ray within [tnear, tfar]. rays: (..., 6) float32 or
@@ -467,7 +658,10 @@ float64, [ox, oy, oz, dx, dy, dz]; t is in units of the direction's length.
 Returns a dict: t_hit (...) float32 (inf on a miss), geometry_ids and
 primitive_ids (...) uint32 (INVALID_ID on a miss), primitive_uvs (..., 2)
 float32 (the hit point is (1-u-v) v0 + u v1 + v v2), primitive_normals
-(..., 3) float32 (unit face normal, (v1 - v0) x (v2 - v0)). coherent=True
+(..., 3) float32 (unit face normal, (v1 - v0) x (v2 - v0) of the placed
+triangle). After the first add_instance or update_vertices also
+instance_ids (...) uint32: the hit instance's id, INVALID_ID on a miss and
+for a hit on a geometry where add_triangles put it. coherent=True
 promises that each group of 8 consecutive rays is alike (camera rays in
 pixel order, create_rays_pinhole's): a packet kernel may then trace them.
 NaN or infinite rays are misses.)doc");
@@ -482,11 +676,13 @@ through a shared edge or vertex counts once.)doc");
           R"doc(Every crossing of every ray (t >= 0), each ray's sorted by t. Returns a dict:
 ray_splits (rays + 1) uint32 (ray i's crossings are [ray_splits[i],
 ray_splits[i+1])), ray_ids, t_hit, geometry_ids, primitive_ids (crossings)
-and primitive_uvs (crossings, 2), rays counted over the flattened leading shape.)doc");
+and primitive_uvs (crossings, 2), rays counted over the flattened leading
+shape; instance_ids as cast_rays'.)doc");
   cls.def("compute_closest_points", &compute_closest_points, py::arg("query_points"), py::arg("nthreads") = 0,
           R"doc(The nearest surface point of each query point ((..., 3) float32 or float64,
 finite). Returns a dict: points (..., 3), geometry_ids, primitive_ids (...)
-uint32, primitive_uvs (..., 2), primitive_normals (..., 3).)doc");
+uint32, primitive_uvs (..., 2), primitive_normals (..., 3); instance_ids as
+cast_rays'.)doc");
   cls.def("compute_distance", &compute_distance, py::arg("query_points"), py::arg("nthreads") = 0,
           R"doc(The distance of each query point to the surface: (...) float32 (inf
 without triangles).)doc");
@@ -516,11 +712,14 @@ majority of nsamples (odd) rays' crossing parities.)doc");
 compute_signed_distance's sign.)doc");
   cls.def_property_readonly("geometry_count", &MeshScene::geometry_count,
                             "The number of meshes added (the next geometry id).");
+  cls.def_property_readonly("instance_count", &MeshScene::instance_count,
+                            "The number of instances added (the next instance id).");
   cls.def("__repr__", [](const MeshScene& scene) {
     return "rtcl.RaycastingScene(device=" + py::repr(py::str(scene.device().info().name)).cast<std::string>() +
            ", accel=" + py::repr(py::str(scene.accel_spec())).cast<std::string>() + ", precision='" +
            std::string(precision_name(scene.config().precision)) +
-           "', meshes=" + std::to_string(scene.geometry_count()) + ")";
+           "', meshes=" + std::to_string(scene.geometry_count()) +
+           ", instances=" + std::to_string(scene.instance_count()) + ")";
   });
   bind_pinhole(cls);
 }

@@ -23,6 +23,7 @@
 #include "rtcl/render/selective.hpp"
 #include "rtcl/render/wavelet.hpp"
 #include "rtcl/scene/scene_file.hpp"
+#include "rtcl/scene/scene_lights.hpp"
 #include "rtcl/scene/showcase_scene.hpp"
 
 namespace rtcl::python {
@@ -198,10 +199,12 @@ void bind_render(py::module_& m) {
         a.batch = batch;
         check_args(a);
         SceneDescription scene = read_scene(scene_arg);
-        if (!scene.notes.empty()) {
-          py::object warn = py::module_::import("warnings").attr("warn");
-          for (const std::string& note : scene.notes) warn("rtcl: note: " + note);
-        }
+        // A scene without lights is lit as `rtcl render` lights it.
+        const LightNotice lights = default_lights(scene, a.method != "beam", "method=\"beam\"");
+        py::object warn = py::module_::import("warnings").attr("warn");
+        for (const std::string& note : scene.notes) warn("rtcl: note: " + note);
+        if (!lights.note.empty()) warn("rtcl: note: " + lights.note);
+        if (!lights.warning.empty()) warn("rtcl: warning: " + lights.warning);
         const Device opened = open_device(device);
         const Image image = render_image(opened, scene, a);
         auto out =
@@ -230,7 +233,10 @@ method: "ray" (every pixel), "selective" (selective_block,
     wavelet_budget) or "beam" (beam_order: "exact" or "key").
 accel, precision: the structure and level (default: the scene file's, else
     "bvh" and "robust"). device: as RaycastingScene's. batch: camera rays per
-    wavefront.)doc");
+    wavefront.
+A scene that declares no light is lit by its emissive triangles, as
+`rtcl render` lights it (docs/cli.md, "Scenes without lights"); notes and
+warnings about the scene come as Python warnings.)doc");
 }
 
 }  // namespace rtcl::python

@@ -1,9 +1,11 @@
 #include "scratch.hpp"
 
 #include <algorithm>
+#include <condition_variable>
+#include <exception>
 #include <mutex>
-
-#include "rtcl/thread_pool.hpp"
+#include <thread>
+#include <utility>
 
 namespace rtcl::python {
 
@@ -39,6 +41,72 @@ ScratchLease::~ScratchLease() {
   p.free.push_back(std::move(scratch_));
 }
 
+namespace {
+
+// The other host thread of one pipeline() call: runs one posted task at a
+// time and sleeps between tasks. (A thread of the library's pool would spin
+// for its next job while the device works, and on a CPU device take a core
+// from the device's own threads.)
+class Helper {
+ public:
+  Helper() : thread_([this] { serve(); }) {}
+  ~Helper() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+    }
+    changed_.notify_all();
+    thread_.join();
+  }
+  Helper(const Helper&) = delete;
+  Helper& operator=(const Helper&) = delete;
+
+  void post(std::function<void()> task) {
+    {
+      std::lock_guard lock(mutex_);
+      task_ = std::move(task);
+      pending_ = true;
+    }
+    changed_.notify_all();
+  }
+  // Waits for the posted task; returns its exception, if any.
+  std::exception_ptr wait() {
+    std::unique_lock lock(mutex_);
+    changed_.wait(lock, [&] { return !pending_; });
+    return std::exchange(error_, nullptr);
+  }
+
+ private:
+  void serve() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      changed_.wait(lock, [&] { return pending_ || stopping_; });
+      if (!pending_) return;
+      std::function<void()> task = std::move(task_);
+      lock.unlock();
+      std::exception_ptr error;
+      try {
+        task();
+      } catch (...) {
+        error = std::current_exception();
+      }
+      lock.lock();
+      error_ = error;
+      pending_ = false;
+      changed_.notify_all();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::function<void()> task_;
+  bool pending_ = false, stopping_ = false;
+  std::exception_ptr error_;
+  std::thread thread_;  // last: starts when the rest is ready
+};
+
+}  // namespace
+
 void pipeline(std::size_t count, const std::function<void(int, std::size_t, std::size_t, bool)>& pack,
               const std::function<void(int, std::size_t, std::size_t)>& run,
               const std::function<void(int, std::size_t, std::size_t, bool)>& unpack) {
@@ -47,20 +115,26 @@ void pipeline(std::size_t count, const std::function<void(int, std::size_t, std:
   auto first = [](std::size_t k) { return k * kChunk; };
   auto size = [&](std::size_t k) { return std::min(kChunk, count - k * kChunk); };
   pack(0, 0, size(0), true);
-  for (std::size_t k = 0; k < chunks; ++k) {
-    const int slot = static_cast<int>(k % 2), other = 1 - slot;
-    if (chunks == 1) {
-      run(slot, first(k), size(k));
-      break;
-    }
-    run_jobs(2, [&](unsigned job) {
-      if (job == 0) {
+  if (chunks == 1) {
+    run(0, 0, size(0));
+  } else {
+    Helper helper;
+    for (std::size_t k = 0; k < chunks; ++k) {
+      const int slot = static_cast<int>(k % 2), other = 1 - slot;
+      helper.post([&, k, other] {
+        if (k > 0) unpack(other, first(k - 1), size(k - 1), false);
+        if (k + 1 < chunks) pack(other, first(k + 1), size(k + 1), false);
+      });
+      std::exception_ptr run_error;
+      try {
         run(slot, first(k), size(k));
-        return;
+      } catch (...) {
+        run_error = std::current_exception();
       }
-      if (k > 0) unpack(other, first(k - 1), size(k - 1), false);
-      if (k + 1 < chunks) pack(other, first(k + 1), size(k + 1), false);
-    });
+      const std::exception_ptr help_error = helper.wait();
+      if (run_error) std::rethrow_exception(run_error);
+      if (help_error) std::rethrow_exception(help_error);
+    }
   }
   unpack(static_cast<int>((chunks - 1) % 2), first(chunks - 1), size(chunks - 1), true);
 }

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
@@ -30,6 +31,7 @@ using HostArray = std::vector<T, DefaultInitAllocator<T>>;
 struct Scratch {
   HostArray<Ray> rays;
   HostArray<Hit> hits;
+  HostArray<std::uint32_t> ids;  // rtcl::Scene's instance ids of the hits
   HostArray<float> xyz;
   HostArray<PointHit> point_hits;
 
@@ -60,11 +62,11 @@ class ScratchLease {
 // pack(slot, first, n, parallel), run(slot, first, n) and
 // unpack(slot, first, n, parallel), where slot (0 or 1) names one of two
 // sets of scratch arrays. run(k) on the calling thread (the device work)
-// overlaps unpack(k - 1) and pack(k + 1) on another host thread
-// (rtcl/thread_pool.hpp), which then run serially (parallel = false); the
-// first pack and the last unpack, overlapping nothing, may use every host
-// thread. The exception of the lowest job that throws is rethrown after the
-// chunk's jobs have returned.
+// overlaps unpack(k - 1) and pack(k + 1) on a helper thread of the call,
+// which sleeps between them (parallel = false); the first pack and the last
+// unpack, overlapping nothing, may use every host thread
+// (rtcl/parallel.hpp). A job's exception is rethrown after the chunk's jobs
+// have returned (run's before the helper's).
 void pipeline(std::size_t count, const std::function<void(int, std::size_t, std::size_t, bool)>& pack,
               const std::function<void(int, std::size_t, std::size_t)>& run,
               const std::function<void(int, std::size_t, std::size_t, bool)>& unpack);

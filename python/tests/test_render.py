@@ -120,3 +120,35 @@ def test_scene_file(tmp_path):
     assert image.shape == (16, 16, 3)
     assert image[8, 8].sum() > image[0, 0].sum()  # the sphere in the middle, lit
     assert np.array_equal(rtcl.render(os.fspath(scene), 16, 16), rtcl.render(scene, 16, 16))
+
+
+def test_emissive_triangles_light_a_scene_without_lights(tmp_path):
+    """As `rtcl render`: with no light declared, the emissive triangles (the
+    Cornell box's lamp, Ke = (17, 12, 4)) light the scene as the light
+    {"type": "emissive"} whose intensity scales the brightest channel to 1
+    would, with a note; without anything emitting, a warning."""
+    from meshes import scenes_dir
+    obj = scenes_dir() / "cornell_box" / "CornellBox-Original.obj"
+    if not obj.exists():
+        pytest.skip(f"{obj} not found (set RTCL_SCENES_DIR)")
+    camera = '"camera": {"position": [0, 1, 3.9], "look_at": [0, 1, 0], "fov": 39.3}'
+    objects = f'"objects": [{{"type": "mesh", "file": "{obj}"}}]'
+    implicit, explicit = tmp_path / "implicit.json", tmp_path / "explicit.json"
+    implicit.write_text("{" + camera + ", " + objects + "}")
+    intensity = float(np.float32(1.0 / 17.0))
+    explicit.write_text("{" + camera + f', "lights": [{{"type": "emissive", "intensity": {intensity!r}}}], '
+                        + objects + "}")
+    with pytest.warns(UserWarning, match=r'implicit.json: no light declared: its 2 emissive triangles light it as '
+                                         r'area lights, as \{"type": "emissive", "intensity": 0.0588\}'):
+        a = rtcl.render(implicit, 24, 24)
+    b = rtcl.render(explicit, 24, 24)
+    assert np.allclose(a, b, rtol=1e-5, atol=1e-5)
+    lit = a.sum(axis=2) > 0.03
+    assert lit.mean() > 0.5  # the walls and blocks are lit, not only the lamp
+    dark = tmp_path / "dark.json"
+    dark.write_text('{"camera": {"position": [0, 0, 3], "look_at": [0, 0, 0]}, "materials": {"m": {}},'
+                    ' "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m"}]}')
+    with pytest.warns(UserWarning, match="dark.json: no light declared and no triangle emits light"):
+        rtcl.render(dark, 8, 8)
+    with pytest.warns(UserWarning, match='no light declared; method="beam" lights by point lights only'):
+        rtcl.render(implicit, 8, 8, method="beam")

@@ -15,7 +15,7 @@
 #include "rates.hpp"
 #include "render_options.hpp"
 #include "render_units.hpp"
-#include "scene_lights.hpp"
+#include "rtcl/scene/scene_lights.hpp"
 #include "rtcl/accel.hpp"
 #include "rtcl/beam/beam_renderer.hpp"
 #include "rtcl/device.hpp"

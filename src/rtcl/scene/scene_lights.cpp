@@ -1,9 +1,9 @@
-#include "scene_lights.hpp"
+#include "rtcl/scene/scene_lights.hpp"
 
 #include <algorithm>
 #include <cstdio>
 
-namespace rtcl::cli {
+namespace rtcl {
 
 namespace {
 
@@ -41,7 +41,7 @@ std::string number(double x) {
 
 }  // namespace
 
-LightNotice default_lights(SceneDescription& scene, bool area_lights) {
+LightNotice default_lights(SceneDescription& scene, bool area_lights, const std::string& point_lights_only) {
   LightNotice notice;
   if (!scene.lights.empty()) return notice;
   const Emitters e = emitters_of(scene);
@@ -54,7 +54,7 @@ LightNotice default_lights(SceneDescription& scene, bool area_lights) {
     return notice;
   }
   if (!area_lights) {
-    notice.warning = scene.source + ": no light declared; --method beam lights by point lights only, so the " +
+    notice.warning = scene.source + ": no light declared; " + point_lights_only + " lights by point lights only, so the " +
                      std::to_string(e.triangles) + " emissive triangle" + plural + " light nothing and " + lit_by;
     return notice;
   }
@@ -70,4 +70,4 @@ LightNotice default_lights(SceneDescription& scene, bool area_lights) {
   return notice;
 }
 
-}  // namespace rtcl::cli
+}  // namespace rtcl
