@@ -18,6 +18,7 @@
 #include "rtcl/scene/scene_bytes.hpp"
 #include "rtcl/scene/scene_file.hpp"
 #include "rtcl/scene/showcase_scene.hpp"
+#include "support/cli_run.hpp"
 #include "support/error_of.hpp"
 #include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
@@ -220,6 +221,26 @@ TEST(RenderInstances, ForestBuildsOneBunnyAndFitsItsMemoryPlusInstanceRecords) {
 TEST(RenderInstances, ForestNeedsTheScenesDirectory) {
   EXPECT_NE(error_of([] { builtin_scene("forest"); }).find("RTCL_SCENES_DIR"), std::string::npos);
   EXPECT_NE(error_of([] { forest_scene("/nonexistent/bunny.obj"); }).find("/nonexistent/bunny.obj"), std::string::npos);
+}
+
+TEST(RenderInstancesCli, ForestAndFramesThroughTheCommandLine) {
+  TempDir dir;
+  expect_usage_error(run_cli(dir, {"render", "--builtin", "forest", "-o", "f.png"}, "RTCL_SCENES_DIR="),
+                     "RTCL_SCENES_DIR");
+  CliRun forest = run_cli(dir, {"render", "--builtin", "forest", "-o", "f.png", "--width", "64", "--verbose"},
+                          "RTCL_SCENES_DIR=" + shell_quoted(scenes_dir()));
+  ASSERT_EQ(forest.status, 0) << forest.err;
+  EXPECT_NE(forest.out.find("two-level scene: 2 meshes, 10001 instances, 2 bottom levels built"), std::string::npos)
+      << forest.out;
+  // An animation of a scene file that shares a mesh: one renderer, each
+  // later frame re-places the moving objects only.
+  SceneFiles files;
+  files.load(true);
+  CliRun frames = run_cli(files.dir, {"render", files.dir.file("scene.json"), "--frames", "0:2", "-o", "a_%d.png",
+                                      "--width", "32", "--verbose"});
+  ASSERT_EQ(frames.status, 0) << frames.err;
+  EXPECT_EQ(count_of(frames.out, "0 bottom levels built, top level rebuilt"), 2u) << frames.out;
+  EXPECT_EQ(count_of(frames.out, "two-level scene:"), 1u) << frames.out;
 }
 
 }  // namespace
