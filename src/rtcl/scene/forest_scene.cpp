@@ -106,8 +106,10 @@ SceneDescription forest_scene(const std::string& bunny_path, const ForestOptions
   plane.shape = ground;
   s.meshes.push_back(std::move(plane));
 
-  s.camera.position = glm::vec3(glm::dvec3(0.0, 0.22 * L + 1.0, 0.5 * L + 0.25 * L + 2.0));
-  s.camera.look_at = glm::vec3(glm::dvec3(0.0, 0.0, 0.1 * L));
+  // A walker's view: low, a few units beyond the front row, down the rows
+  // to the horizon.
+  s.camera.position = glm::vec3(glm::dvec3(0.0, 2.5, 0.5 * L + 4.0));
+  s.camera.look_at = glm::vec3(glm::dvec3(0.0, 0.4, 0.5 * L - 8.0));
   s.camera.fov_deg = 45.0f;
   s.camera.aspect = 16.0f / 9.0f;
   s.ambient = glm::vec3(0.25f);
