@@ -36,8 +36,8 @@ const char* cube_obj =
 const char* floor_obj = "v -4 0 -4\nv 4 0 -4\nv 4 0 4\nv -4 0 4\nf 1 3 2\nf 1 4 3\n";
 
 // Four objects of cube.obj in white (one shape: turned, mirrored,
-// non-uniformly scaled), one in glass (a second shape), the floor, a
-// mirror sphere and, with `motion`, a moving white cube and a moving sphere.
+// non-uniformly scaled), one in glass (a second shape, mirrored: refraction
+// tells inside from outside by the winding), the floor, a mirror sphere and, with `motion`, a moving white cube and a moving sphere.
 std::string scene_json(bool motion) {
   std::string moving =
       motion ? R"(, {"type": "mesh", "file": "cube.obj", "material": "white",
@@ -61,7 +61,8 @@ std::string scene_json(bool motion) {
        "transform": {"scale": [-0.6, 1.4, 0.8], "translate": [1.4, 0.7, -0.4]}},
       {"type": "mesh", "file": "cube.obj", "material": "white",
        "transform": {"scale": [0.5, 0.3, 1.2], "rotate": [20, 0, 10], "translate": [-0.3, 0.3, 1.0]}},
-      {"type": "mesh", "file": "cube.obj", "material": "glass", "transform": {"scale": 0.6, "translate": [0.9, 0.31, 0.9]}},
+      {"type": "mesh", "file": "cube.obj", "material": "glass",
+       "transform": {"scale": [-0.6, 0.6, 0.6], "translate": [0.9, 0.31, 0.9]}},
       {"type": "sphere", "center": [-0.1, 0.45, 0.1], "radius": 0.45, "material": "mirror"})" +
          moving + "]}";
 }
