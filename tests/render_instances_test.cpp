@@ -7,10 +7,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "rtcl/accel.hpp"
 #include "rtcl/error.hpp"
+#include "rtcl/render/instanced_scene.hpp"
 #include "rtcl/render/renderer.hpp"
 #include "rtcl/render/render_layouts.hpp"
 #include "rtcl/scene/forest_scene.hpp"
@@ -177,6 +181,43 @@ TEST(RenderInstances, FramesReplaceOnlyMovingObjectsAndMatchSingleFrames) {
   // The flat path has no re-placing.
   Renderer flat(test_device(), unshare_meshes(scene), "bvh");
   EXPECT_NE(error_of([&] { flat.set_shutter(1.0f, 2.0f); }).find("flat path"), std::string::npos);
+}
+
+// An emitting mesh placed twice lights the scene twice: the emissive
+// light expands over both objects' triangles, exactly the flat path's list.
+TEST(RenderInstances, EmissiveLightsExpandPerObject) {
+  SceneDescription scene = SceneFiles().load(false);
+  Material lamp;
+  lamp.name = "lamp";
+  lamp.emission = glm::vec3(4.0f);
+  scene.materials.push_back(lamp);
+  auto panel = std::make_shared<MeshShape>();
+  panel->vertices = {{-0.3f, 0, -0.3f}, {0.3f, 0, -0.3f}, {0.3f, 0, 0.3f}, {-0.3f, 0, 0.3f}};
+  panel->triangles = {{0, 1, 2}, {0, 2, 3}};
+  panel->materials.assign(2, static_cast<std::uint32_t>(scene.materials.size() - 1));
+  for (double x : {-1.0, 1.0}) {
+    SceneMesh m;
+    m.name = "panel";
+    m.shape = panel;
+    m.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(x, 2.5, 0.0)) *
+                  glm::rotate(glm::dmat4(1.0), glm::radians(180.0), glm::dvec3(1, 0, 0));
+    scene.meshes.push_back(m);
+  }
+  Light emissive;
+  emissive.shape = LightShape::emissive;
+  scene.lights.push_back(emissive);
+  std::vector<Light> got = instanced_lights(scene);
+  std::vector<Light> want = expand_emissive_lights(scene, flatten(scene));
+  ASSERT_EQ(got.size(), want.size());
+  ASSERT_EQ(got.size(), scene.lights.size() - 1 + 4) << "two triangles per panel, two panels";
+  for (std::size_t l = 0; l < got.size(); ++l) {
+    EXPECT_EQ(got[l].position, want[l].position) << l;
+    EXPECT_EQ(got[l].edge1, want[l].edge1) << l;
+    EXPECT_EQ(got[l].color, want[l].color) << l;
+  }
+  // A moving emitter is refused, as on the flat path.
+  scene.meshes.back().end_transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.2, 0, 0)) * scene.meshes.back().transform;
+  EXPECT_NE(error_of([&] { instanced_lights(scene); }).find("must not move"), std::string::npos);
 }
 
 TEST(RenderInstances, OtherStructuresAreRefusedForInstancedScenes) {
