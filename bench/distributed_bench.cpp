@@ -66,9 +66,10 @@ SceneDescription cornell_soft() {
   scene.materials.push_back(glass);
   SceneMesh sm;
   sm.name = "CornellBox-Original.obj";
-  sm.vertices = std::move(mesh.geometry.vertices);
-  sm.triangles = std::move(mesh.geometry.triangles);
-  sm.materials = std::move(mesh.triangle_material);
+  rtcl::MeshShape& shape = sm.edit_shape();
+  shape.vertices = std::move(mesh.geometry.vertices);
+  shape.triangles = std::move(mesh.geometry.triangles);
+  shape.materials = std::move(mesh.triangle_material);
   scene.meshes.push_back(std::move(sm));
   scene.spheres.push_back(SceneSphere::still({0.32, 0.8, 0.37}, 0.2, base));
   scene.spheres.push_back(SceneSphere::still({-0.45, 0.25, 0.55}, 0.25, base + 1));

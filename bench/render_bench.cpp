@@ -52,9 +52,10 @@ SceneDescription render_scene(const SceneSpec& spec, float kr) {
   }
   SceneMesh sm;
   sm.name = spec.file;
-  sm.vertices = std::move(mesh.geometry.vertices);
-  sm.triangles = std::move(mesh.geometry.triangles);
-  sm.materials = std::move(mesh.triangle_material);
+  rtcl::MeshShape& shape = sm.edit_shape();
+  shape.vertices = std::move(mesh.geometry.vertices);
+  shape.triangles = std::move(mesh.geometry.triangles);
+  shape.materials = std::move(mesh.triangle_material);
   scene.meshes.push_back(std::move(sm));
   return scene;
 }

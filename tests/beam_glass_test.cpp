@@ -125,8 +125,9 @@ SceneDescription prism_scene() {
   wall.diffuse = {0.7f, 0.5f, 0.3f};
   wall.ambient = glm::vec3(1.0f);
   scene.materials = {glass, wall};
-  SceneMesh m;
-  m.name = "prism and wall";
+  SceneMesh mesh;
+  mesh.name = "prism and wall";
+  MeshShape& m = mesh.edit_shape();
   const float a = 1.2f;
   // Prism: hypotenuse z = 0, apex edge at z = -a, y in [-a, a].
   m.vertices = {{-a, -a, 0}, {a, -a, 0}, {0, -a, -a}, {-a, a, 0}, {a, a, 0}, {0, a, -a},
@@ -139,7 +140,7 @@ SceneDescription prism_scene() {
                  {0, 2, 1}, {3, 4, 5},  // caps
                  {6, 8, 7}, {6, 9, 8}};  // wall, normal -z
   m.materials = {0, 0, 0, 0, 0, 0, 0, 0, 1, 1};
-  scene.meshes.push_back(m);
+  scene.meshes.push_back(mesh);
   return scene;
 }
 
@@ -180,8 +181,9 @@ TEST(BeamGlass, SlabWeightsAreTheFresnelSeries) {
   wall.diffuse = glm::vec3(0.0f);
   wall.emission = glm::vec3(1.0f);
   scene.materials = {glass, wall};
-  SceneMesh m;
-  m.name = "slab and wall";
+  SceneMesh mesh;
+  mesh.name = "slab and wall";
+  MeshShape& m = mesh.edit_shape();
   m.vertices = {{-10, -10, 0.1f}, {10, -10, 0.1f}, {10, 10, 0.1f}, {-10, 10, 0.1f},
                 {-10, -10, -0.1f}, {10, -10, -0.1f}, {10, 10, -0.1f}, {-10, 10, -0.1f},
                 {-10, -10, -5}, {10, -10, -5}, {10, 10, -5}, {-10, 10, -5}};
@@ -189,7 +191,7 @@ TEST(BeamGlass, SlabWeightsAreTheFresnelSeries) {
                  {4, 6, 5}, {4, 7, 6},     // back face, normal -z (outward)
                  {8, 9, 10}, {8, 10, 11}};  // wall, facing the slab
   m.materials = {0, 0, 0, 0, 1, 1};
-  scene.meshes.push_back(m);
+  scene.meshes.push_back(mesh);
   beam::BeamSettings bs;
   bs.width = bs.height = 16;
   bs.min_weight = 1e-4f;  // the second term's beams weigh 9.7e-4

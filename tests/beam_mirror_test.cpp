@@ -66,7 +66,8 @@ TEST(BeamMirror, MirrorSceneMatchesRayTracerAt64Spp) {
   // and third levels (worlds of two and three M_r).
   std::uint32_t mirror = 0;
   while (scene.materials[mirror].name != "green_mirror") ++mirror;  // no highlight: see below
-  scene.meshes[0].materials[0] = scene.meshes[0].materials[1] = mirror;
+  MeshShape& room = scene.meshes[0].edit_shape();
+  room.materials[0] = room.materials[1] = mirror;
   Renderer renderer(test_device(), scene, "bvh");
   for (auto [w, depth] : {std::pair<std::uint32_t, std::uint32_t>{48, 0}, {48, 1}, {48, 5}}) {
     const std::uint32_t h = w;

@@ -101,7 +101,7 @@ TEST(MotionScene, SceneBytesKeepTheKeyframes) {
   s.meshes.back().end_transform = glm::translate(glm::dmat4(1.0), dvec3(1, 0, 0)) * s.meshes.back().transform;
   s.meshes.back().motion_key = "m.json: objects[1].motion";
   s.materials.push_back(default_scene().materials.at(5));
-  s.meshes.back().materials.assign(s.meshes.back().triangles.size(), 1);
+  s.meshes.back().edit_shape().materials.assign(s.meshes.back().triangles().size(), 1);
   SceneDescription r = scene_from_bytes(scene_to_bytes(s), "bytes");
   EXPECT_EQ(r.camera.shutter_open, 0.1f);
   EXPECT_EQ(r.camera.shutter_close, 0.6f);

@@ -13,6 +13,7 @@
 
 #include "rtcl/render/image.hpp"
 #include "support/cli_run.hpp"
+#include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 
 namespace rtcl::test {
@@ -74,6 +75,19 @@ TEST(MpiRender, TwoAndThreeRanksGiveTheSingleProcessImage) {
       EXPECT_NE(run.out.find("rank " + std::to_string(r) + " (host"), std::string::npos) << run.out;
     expect_same_pixels(read_image(dir.file(out)), reference, std::to_string(ranks) + " ranks");
   }
+}
+
+// The forest's 10,000 bunnies share one mesh: rank 0 broadcasts it once
+// (scene bytes keep the sharing) and every rank traces through two levels.
+TEST(MpiRender, TheForestOfInstancesGivesTheSingleProcessImage) {
+  TempDir dir;
+  const std::string scenes = "RTCL_SCENES_DIR=" + shell_quoted(scenes_dir());
+  const std::vector<std::string> args{"render", "-q", "--builtin", "forest", "--width", "64", "--height", "36", "--spp", "2"};
+  CliRun one = run_cli(dir, with(args, {"-o", "single.exr"}), scenes);
+  ASSERT_EQ(one.status, 0) << one.err;
+  CliRun run = run_cli_launched(dir, mpirun(2), with(args, {"--tile", "16", "-o", "mpi.exr"}), mpi_rank_env(scenes));
+  ASSERT_EQ(run.status, 0) << run.err;
+  expect_same_pixels(read_image(dir.file("mpi.exr")), read_image(dir.file("single.exr")), "the forest on 2 ranks");
 }
 
 TEST(MpiRender, TileSizeOrderAndSceneSourceDoNotChangeTheImage) {

@@ -93,8 +93,9 @@ TEST(Render, JitteredSamplesMatchReference) {
 
 // An axis-aligned box with outward faces.
 SceneMesh box_mesh(glm::vec3 lo, glm::vec3 hi, std::uint32_t material) {
-  SceneMesh m;
-  m.name = "box";
+  SceneMesh out;
+  out.name = "box";
+  MeshShape& m = out.edit_shape();
   for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
   // quads by corner bits, each listed counter-clockwise seen from outside
   const std::uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
@@ -103,7 +104,7 @@ SceneMesh box_mesh(glm::vec3 lo, glm::vec3 hi, std::uint32_t material) {
     m.triangles.push_back({q[0], q[2], q[3]});
   }
   m.materials.assign(m.triangles.size(), material);
-  return m;
+  return out;
 }
 
 // A glass slab 1 unit thick (z in [-0.5, 0.5]), 40 units wide.

@@ -35,9 +35,9 @@ void expect_same(const SceneDescription& a, const SceneDescription& b) {
   ASSERT_EQ(a.meshes.size(), b.meshes.size());
   for (std::size_t i = 0; i < a.meshes.size(); ++i) {
     EXPECT_EQ(a.meshes[i].name, b.meshes[i].name);
-    EXPECT_EQ(a.meshes[i].vertices, b.meshes[i].vertices);
-    EXPECT_EQ(a.meshes[i].triangles, b.meshes[i].triangles);
-    EXPECT_EQ(a.meshes[i].materials, b.meshes[i].materials);
+    EXPECT_EQ(a.meshes[i].vertices(), b.meshes[i].vertices());
+    EXPECT_EQ(a.meshes[i].triangles(), b.meshes[i].triangles());
+    EXPECT_EQ(a.meshes[i].materials(), b.meshes[i].materials());
     EXPECT_EQ(a.meshes[i].transform, b.meshes[i].transform);
   }
   ASSERT_EQ(a.spheres.size(), b.spheres.size());

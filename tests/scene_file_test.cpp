@@ -53,7 +53,7 @@ const std::string sphere = "{\"type\": \"sphere\", \"center\": [0, 0, 0], \"radi
 TEST(SceneFile, ShippedScenesLoad) {
   SceneDescription cornell = load_scene(std::string(RTCL_SOURCE_DIR) + "/scenes/cornell.json");
   ASSERT_EQ(cornell.meshes.size(), 1u);
-  EXPECT_EQ(cornell.meshes[0].triangles.size(), 36u);
+  EXPECT_EQ(cornell.meshes[0].triangles().size(), 36u);
   ASSERT_EQ(cornell.spheres.size(), 2u);
   EXPECT_NEAR(cornell.spheres[0].radius, 0.2, 1e-12) << "sphere transform applied";
   EXPECT_NEAR(cornell.spheres[0].center.y, 0.8, 1e-12);
@@ -273,7 +273,7 @@ TEST(Scene, InvalidScenesAreRejected) {
   s.camera.up = glm::vec3(0.0f, 0.0f, 1.0f);  // parallel to the view direction
   EXPECT_THROW(validate(s), Error);
   s = default_scene();
-  s.meshes[0].materials[0] = 99;
+  s.meshes[0].edit_shape().materials[0] = 99;
   EXPECT_THROW(flatten(s), Error);
   s = default_scene();
   EXPECT_THROW(transform_scene(s, glm::dmat4(glm::dvec4(1, 0, 0, 0), glm::dvec4(0, 2, 0, 0), glm::dvec4(0, 0, 1, 0),

@@ -31,9 +31,10 @@ rtcl::SceneDescription soup_scene(std::size_t triangles) {
   scene.spheres.clear();
   rtcl::SceneMesh mesh;
   mesh.name = "soup";
-  mesh.vertices = std::move(g.vertices);
-  mesh.triangles = std::move(g.triangles);
-  mesh.materials.assign(mesh.triangles.size(), 0);
+  rtcl::MeshShape& shape = mesh.edit_shape();
+  shape.vertices = std::move(g.vertices);
+  shape.triangles = std::move(g.triangles);
+  shape.materials.assign(shape.triangles.size(), 0);
   scene.meshes.push_back(std::move(mesh));
   return scene;
 }

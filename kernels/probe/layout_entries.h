@@ -129,6 +129,11 @@ RTCL_PROBE_RECORD(ShadeSphere)
 RTCL_PROBE_FIELD(ShadeSphere, center) RTCL_PROBE_FIELD(ShadeSphere, radius)
 RTCL_PROBE_FIELD(ShadeSphere, material)
 
+RTCL_PROBE_RECORD(ShadeInstance)
+RTCL_PROBE_FIELD(ShadeInstance, open) RTCL_PROBE_FIELD(ShadeInstance, close)
+RTCL_PROBE_FIELD(ShadeInstance, first_triangle) RTCL_PROBE_FIELD(ShadeInstance, first_sphere)
+RTCL_PROBE_FIELD(ShadeInstance, triangle_count) RTCL_PROBE_FIELD(ShadeInstance, flags)
+
 RTCL_PROBE_SIZE(RTCL_RADIANCE_BYTES, float4)
 RTCL_PROBE_SIZE(RTCL_CHUNK_COUNT_BYTES, uint2)
 RTCL_PROBE_SIZE(RTCL_FLAG_BYTES, uint)

@@ -18,7 +18,11 @@
  * roughness > 0), RTCL_HAS_MOTION (moving primitives: triangles and spheres
  * hold shutter open, triangles_close and spheres_close shutter close, and a
  * path's primitives lie at open + tau * (close - open), tau its sample's
- * time, as in accel/bvh_motion.cl). */
+ * time, as in accel/bvh_motion.cl), RTCL_HAS_INSTANCES (the two-level
+ * path: triangles and spheres hold each mesh once in object space, a hit's
+ * object comes from hit_instances and its ShadeInstance places the
+ * primitive in the world), RTCL_HAS_MOVING_INSTANCES (some object moves:
+ * its transform is the blend at the path's time tau). */
 #include "shared/layouts.h"
 #include "shared/render_layouts.h"
 #include "shared/sampling.h"
@@ -128,6 +132,54 @@ inline SurfacePoint surface_point(const Ray r, const Hit h, global const ShadeTr
   return s;
 }
 
+#ifdef RTCL_HAS_INSTANCES
+/* The point p of object space in the world, under the 3x4 row-major m. */
+inline float3 instance_point(const float* m, float3 p) {
+  return (float3)(m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
+                  m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]);
+}
+
+/* The hit on primitive h.prim of object `k`: its primitive's record (object
+ * space) moved into the world by the object's transform at time tau (the
+ * blend of instances.cl), then as surface_point: the geometric normal from
+ * the world triangle's edges (the normal matrix of the transform, applied
+ * exactly), flipped for a mirroring transform as flatten() swaps corners;
+ * a sphere (of an identity or uniformly scaling transform) by its world
+ * centre and radius. */
+inline SurfacePoint instance_surface_point(const Ray r, const Hit h, uint k, global const ShadeInstance* instances,
+                                           global const ShadeTriangle* triangles,
+                                           global const ShadeSphere* spheres, float tau) {
+  global const ShadeInstance* in = instances + k;
+  float m[12];
+  for (int j = 0; j < 12; ++j) m[j] = in->open[j] + tau * (in->close[j] - in->open[j]);
+  SurfacePoint s;
+#ifdef RTCL_HAS_SPHERES
+  if ((uint)h.prim >= in->triangle_count) {
+    global const ShadeSphere* sp = spheres + in->first_sphere + ((uint)h.prim - in->triangle_count);
+    float3 c = instance_point(m, load3g(sp->center));
+    float radius = sp->radius * length((float3)(m[0], m[4], m[8]));
+    float3 p = (float3)(r.ox, r.oy, r.oz) + h.t * (float3)(r.dx, r.dy, r.dz);
+    s.ng = normalize(p - c);
+    s.p = c + radius * s.ng;
+    s.offset = RTCL_SPAWN_OFFSET(s.p, radius);
+    s.material = sp->material;
+    return s;
+  }
+#endif
+  global const ShadeTriangle* t = triangles + in->first_triangle + h.prim;
+  float3 v0 = instance_point(m, load3g(t->v[0]));
+  float3 e1 = instance_point(m, load3g(t->v[1])) - v0, e2 = instance_point(m, load3g(t->v[2])) - v0;
+  float extent = fmax(max3(fabs(e1)), max3(fabs(e2)));
+  s.p = v0 + h.u * e1 + h.v * e2;
+  float inv = 1.0f / extent;
+  s.ng = normalize(cross(e1 * inv, e2 * inv));
+  if (in->flags & RTCL_SHADE_MIRRORED) s.ng = -s.ng;
+  s.offset = RTCL_SPAWN_OFFSET(s.p, extent);
+  s.material = t->material;
+  return s;
+}
+#endif
+
 inline Ray make_ray(float3 o, float3 d, float tmax) {
   Ray r;
   r.ox = o.x;
@@ -217,6 +269,9 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
 #ifdef RTCL_PIXEL_SLOTS
                        , global const uint* pixel_list
 #endif
+#ifdef RTCL_HAS_INSTANCES
+                       , global const ShadeInstance* instances, global const uint* hit_instances
+#endif
                        ) {
   uint i = get_global_id(0);
   if (i >= count) return;
@@ -243,10 +298,17 @@ kernel void shade_hits(global const Ray* rays, global const Hit* hits, global co
   }
   Ray r = rays[i];
   float3 d = normalize((float3)(r.dx, r.dy, r.dz));
-#ifdef RTCL_HAS_MOTION
+#if defined(RTCL_HAS_MOTION) || defined(RTCL_HAS_MOVING_INSTANCES)
   const float tau = rtcl_sample_time(P.sampler, P.seed, image_pixel, sample, P.spp);
 #endif
+#ifdef RTCL_HAS_INSTANCES
+#ifndef RTCL_HAS_MOVING_INSTANCES
+  const float tau = 0.0f;
+#endif
+  SurfacePoint s = instance_surface_point(r, h, hit_instances[i], instances, triangles, spheres, tau);
+#else
   SurfacePoint s = surface_point(r, h, triangles, P.triangle_count, spheres MOTION_SURFACE_ARGS);
+#endif
   global const DeviceMaterial* m = materials + s.material;
   float cos_i = -dot(d, s.ng);
   int front = cos_i > 0.0f; /* the ray arrives on the side the normal points to */

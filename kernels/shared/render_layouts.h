@@ -97,6 +97,27 @@ typedef struct ShadeSphere {
   rtcl_u32 material;
 } ShadeSphere;
 
+/* An object as the shade kernel sees it on the renderer's two-level path
+ * (src/rtcl/render/instanced_scene.hpp): the object-to-world transforms at
+ * shutter open and close (3x4 row-major, x' = m[0] x + m[1] y + m[2] z +
+ * m[3], ..., as InstanceMotion; close = open for a still object; at the
+ * ray's time tau the transform is open + tau * (close - open), element by
+ * element in float, as the trace's), its mesh's first ShadeTriangle and
+ * ShadeSphere (object space, shared by every object of the mesh), the
+ * mesh's triangle count (prim ids below it are triangles, the rest
+ * spheres) and flags (RTCL_SHADE_MIRRORED: the transform's determinant is
+ * negative, so the winding's normal is flipped to keep faces outward).
+ * 112 bytes. */
+#define RTCL_SHADE_MIRRORED 1u
+typedef struct ShadeInstance {
+  float open[12];
+  float close[12];
+  rtcl_u32 first_triangle;
+  rtcl_u32 first_sphere;
+  rtcl_u32 triangle_count;
+  rtcl_u32 flags;
+} ShadeInstance;
+
 /* Entry sizes of the buffers the kernels address as vectors or plain
  * words rather than as records (tests/layout_probe_test.cpp checks each
  * against the device compiler's sizeof):

@@ -62,7 +62,8 @@ Device open_device_flag(const std::string& selector) {
 
 SceneDescription builtin_scene_flag(const std::string& name) {
   try {
-    return builtin_scene(name);
+    const char* scenes_dir = std::getenv("RTCL_SCENES_DIR");
+    return builtin_scene(name, scenes_dir ? scenes_dir : "");
   } catch (const Error& e) {
     std::string message = renamed(e.what(), "builtin_scene name", name, "--builtin");
     if (message.empty()) throw;

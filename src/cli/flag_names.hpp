@@ -35,8 +35,8 @@ void require_precision_flag(const DeviceInfo& device, Precision precision);
 // plain Error (exit 1).
 Device open_device_flag(const std::string& selector);
 
-// builtin_scene(name) under "--builtin NAME": "--builtin x: unknown
-// built-in scene (known: default, showcase)".
+// builtin_scene(name, $RTCL_SCENES_DIR) under "--builtin NAME":
+// "--builtin x: unknown built-in scene (known: default, showcase, forest)".
 SceneDescription builtin_scene_flag(const std::string& name);
 
 // The image formats --output takes, by extension: 8-bit sRGB and linear

@@ -125,13 +125,28 @@ void run(const RenderOptions& o) {
   require_precision_flag(device.info(), plan.config.precision);
   std::unique_ptr<Renderer> renderer;
   for (const RenderUnit& unit : units.units) {
-    // A frame is a scene of its own (its shutter interval); a sweep's
-    // images share the renderer.
-    if (!renderer || units.kind == UnitKind::frames)
+    // A frame is a scene of its own (its shutter interval), except on the
+    // two-level path, where the frame's shutter re-places the moving
+    // objects (the top level is rebuilt, no mesh); a sweep's images share
+    // the renderer.
+    if (renderer && units.kind == UnitKind::frames && renderer->instanced()) {
+      const Camera& camera = unit_scene(scene, units, unit).camera;
+      CommitStats commit = renderer->set_shutter(camera.shutter_open, camera.shutter_close);
+      if (o.verbose)
+        std::printf("rtcl render: frame %lld: %zu bottom levels built, top level %s\n", (long long)unit.frame,
+                    commit.bottom_levels_built, commit.top_level_built ? "rebuilt" : "kept");
+    } else if (!renderer || units.kind == UnitKind::frames)
       // A structure given by --accel is named so in the renderer's errors.
       renderer = naming_accel_flag(o.accel, [&] {
         return std::make_unique<Renderer>(device, unit_scene(scene, units, unit), plan.accel, plan.config);
       });
+    if (o.verbose && renderer->instanced() && unit.output == units.units.front().output) {
+      const SceneStats st = renderer->scene()->stats();
+      std::printf("rtcl render: two-level scene: %zu meshes, %zu instances, %zu bottom levels built, %.1f MiB "
+                  "structure + %.1f MiB shading records on the device\n",
+                  st.meshes, st.instances, st.bottom_levels_built, st.device_bytes / 1048576.0,
+                  renderer->shading_bytes() / 1048576.0);
+    }
     RenderPlan unit_plan = plan;
     unit_plan.settings.spp = unit.spp;
     if (o.method != "ray") {
@@ -225,8 +240,9 @@ void add_render_command(CLI::App& app) {
   cmd->add_option("scene", o->scene, "Scene file (JSON, docs/file-formats.md); none: a built-in scene (--builtin)");
   cmd->add_option("--builtin", o->builtin,
                   "Built-in scene when no scene file is given: default (Whitted: mirror, glass, hard shadows) | "
-                  "showcase (area light, glossy, glass, depth of field, motion blur)")
-      ->check(one_of({"default", "showcase"}, "built-in scene"));
+                  "showcase (area light, glossy, glass, depth of field, motion blur) | forest (10,000 instances of "
+                  "the Stanford bunny from $RTCL_SCENES_DIR, a few of them moving)")
+      ->check(one_of({"default", "showcase", "forest"}, "built-in scene"));
   cmd->add_option("-o,--output", o->output,
                   "Output image; the extension picks the format: " + image_formats_text() +
                       "; with --frames or --spp-sweep a pattern with one %d or %04d field")

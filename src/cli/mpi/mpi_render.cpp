@@ -221,7 +221,7 @@ void run(MpiWorld& world, const RenderOptions& o) {
     // tile rendered and dropped keeps that out of the tiles' times.
     mine.renderer->render(plan.settings, tiles.front());
     report["setup_ms"] = ms_since(start);
-    report["build_ms"] = mine.renderer->accel().stats().build_ms;
+    report["build_ms"] = mine.renderer->build_ms();
     return report;
   };
   // Job j is tile j % tiles of unit j / tiles: the units' tiles in unit

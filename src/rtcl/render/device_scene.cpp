@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <set>
 
+#include "rtcl/render/instanced_scene.hpp"
 #include "rtcl/render/render_layouts.hpp"
 #include "rtcl/scene/orthonormal_basis.hpp"
 
@@ -68,7 +69,11 @@ DeviceLight pack(const Light& l) {
 }  // namespace
 
 std::vector<std::string> shade_defines(const SceneDescription& scene, const FlatScene& flat) {
-  std::set<std::uint32_t> used(flat.material.begin(), flat.material.end());
+  return shade_defines(scene, std::set<std::uint32_t>(flat.material.begin(), flat.material.end()),
+                       !flat.geometry.spheres.empty());
+}
+
+std::vector<std::string> shade_defines(const SceneDescription& scene, const std::set<std::uint32_t>& used, bool spheres) {
   bool reflection = false, refraction = false, glossy = false, area = false;
   for (std::uint32_t m : used) {
     reflection = reflection || scene.materials[m].reflective() || scene.materials[m].transmissive();
@@ -77,7 +82,7 @@ std::vector<std::string> shade_defines(const SceneDescription& scene, const Flat
   }
   for (const Light& l : scene.lights) area = area || l.area();
   std::vector<std::string> defines{"RTCL_LIGHT_COUNT=" + std::to_string(scene.lights.size())};
-  if (!flat.geometry.spheres.empty()) defines.push_back("RTCL_HAS_SPHERES");
+  if (spheres) defines.push_back("RTCL_HAS_SPHERES");
   if (reflection) defines.push_back("RTCL_HAS_REFLECTION");
   if (refraction) defines.push_back("RTCL_HAS_REFRACTION");
   if (glossy) defines.push_back("RTCL_HAS_GLOSSY");
@@ -114,21 +119,26 @@ ShadeRecords shade_records(const FlatScene& flat) {
   return r;
 }
 
-}  // namespace
-
-DeviceScene upload_scene(const Device& device, const SceneDescription& scene, const FlatScene& flat, const FlatScene* close) {
-  const Geometry& g = flat.geometry;
-  ShadeRecords records = shade_records(flat);
+// Materials and lights of the scene on the device.
+void upload_materials_and_lights(const Device& device, const SceneDescription& scene, DeviceScene& d) {
   std::vector<DeviceMaterial> materials;
   for (const Material& m : scene.materials) materials.push_back(pack(m));
   if (materials.empty()) materials.emplace_back();
   std::vector<DeviceLight> lights(std::max<std::size_t>(scene.lights.size(), 1));
   for (std::size_t l = 0; l < scene.lights.size(); ++l) lights[l] = pack(scene.lights[l]);
+  d.materials = device.upload(materials.data(), materials.size() * sizeof(DeviceMaterial), "materials");
+  d.lights = device.upload(lights.data(), lights.size() * sizeof(DeviceLight), "lights");
+}
+
+}  // namespace
+
+DeviceScene upload_scene(const Device& device, const SceneDescription& scene, const FlatScene& flat, const FlatScene* close) {
+  const Geometry& g = flat.geometry;
+  ShadeRecords records = shade_records(flat);
   DeviceScene d;
   d.triangles = device.upload(records.triangles.data(), records.triangles.size() * sizeof(ShadeTriangle), "shading triangles");
   d.spheres = device.upload(records.spheres.data(), records.spheres.size() * sizeof(ShadeSphere), "shading spheres");
-  d.materials = device.upload(materials.data(), materials.size() * sizeof(DeviceMaterial), "materials");
-  d.lights = device.upload(lights.data(), lights.size() * sizeof(DeviceLight), "lights");
+  upload_materials_and_lights(device, scene, d);
   d.triangle_count = static_cast<std::uint32_t>(g.triangles.size());
   d.sphere_count = static_cast<std::uint32_t>(g.spheres.size());
   d.light_count = static_cast<std::uint32_t>(scene.lights.size());
@@ -140,6 +150,20 @@ DeviceScene upload_scene(const Device& device, const SceneDescription& scene, co
     d.spheres_close = device.upload(end.spheres.data(), end.spheres.size() * sizeof(ShadeSphere), "shading spheres at shutter close");
     d.defines.push_back("RTCL_HAS_MOTION");
   }
+  return d;
+}
+
+DeviceScene upload_instanced_scene(const Device& device, const SceneDescription& scene, const InstancedScene& instanced) {
+  DeviceScene d;
+  d.triangles = instanced.triangles();
+  d.spheres = instanced.spheres();
+  upload_materials_and_lights(device, scene, d);
+  d.light_count = static_cast<std::uint32_t>(scene.lights.size());
+  const std::vector<std::uint32_t>& used = instanced.used_materials();
+  d.defines = shade_defines(scene, std::set<std::uint32_t>(used.begin(), used.end()), instanced.has_spheres());
+  d.defines.push_back("RTCL_HAS_INSTANCES");
+  if (instanced.moving()) d.defines.push_back("RTCL_HAS_MOVING_INSTANCES");
+  d.generate_defines = generate_defines(scene);
   return d;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,8 @@
 #include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl {
+
+class InstancedScene;
 
 struct DeviceScene {
   cl::Buffer triangles;  // ShadeTriangle per triangle id
@@ -33,10 +36,18 @@ struct DeviceScene {
 };
 
 std::vector<std::string> shade_defines(const SceneDescription& scene, const FlatScene& flat);
+// The same from the materials the primitives use and whether any is a sphere.
+std::vector<std::string> shade_defines(const SceneDescription& scene, const std::set<std::uint32_t>& used_materials,
+                                       bool spheres);
 std::vector<std::string> generate_defines(const SceneDescription& scene);
 // `flat`: the primitives (at shutter open when the scene moves); `close`:
 // the same primitives at shutter close, for a moving scene only.
 DeviceScene upload_scene(const Device& device, const SceneDescription& scene, const FlatScene& flat,
                          const FlatScene* close = nullptr);
+// The two-level path's (instanced_scene.hpp): materials, lights and defines
+// of `scene` (its emissive lights expanded); triangles and spheres are the
+// InstancedScene's records. Defines RTCL_HAS_INSTANCES, and
+// RTCL_HAS_MOVING_INSTANCES when an object moves.
+DeviceScene upload_instanced_scene(const Device& device, const SceneDescription& scene, const InstancedScene& instanced);
 
 }  // namespace rtcl

@@ -23,6 +23,9 @@ static_assert(sizeof(ShadeParams) == 56 && offsetof(ShadeParams, min_weight) == 
               offsetof(ShadeParams, light_samples) == 48 && offsetof(ShadeParams, shadow_slots) == 52);
 static_assert(sizeof(ShadeTriangle) == 40 && offsetof(ShadeTriangle, material) == 36);
 static_assert(sizeof(ShadeSphere) == 20 && offsetof(ShadeSphere, radius) == 12 && offsetof(ShadeSphere, material) == 16);
+static_assert(sizeof(ShadeInstance) == 112 && offsetof(ShadeInstance, close) == 48 &&
+              offsetof(ShadeInstance, first_triangle) == 96 && offsetof(ShadeInstance, first_sphere) == 100 &&
+              offsetof(ShadeInstance, triangle_count) == 104 && offsetof(ShadeInstance, flags) == 108);
 
 static_assert(RTCL_RADIANCE_BYTES == 4 * sizeof(float) && RTCL_CHUNK_COUNT_BYTES == 2 * sizeof(rtcl_u32) &&
               RTCL_FLAG_BYTES == sizeof(rtcl_u32));

@@ -7,6 +7,7 @@
 #include "rtcl/error.hpp"
 #include "rtcl/render/camera.hpp"
 #include "rtcl/render/device_scene.hpp"
+#include "rtcl/render/instanced_scene.hpp"
 #include "rtcl/render/launch.hpp"
 #include "rtcl/render/ray_queue.hpp"
 #include "rtcl/render/render_layouts.hpp"
@@ -73,6 +74,8 @@ struct Renderer::State {
   FlatScene flat;
   std::unique_ptr<Accel> accel;       // static scenes
   std::unique_ptr<MotionBvh> motion;  // moving scenes
+  std::unique_ptr<InstancedScene> instanced;  // scenes that share mesh shapes (the two-level path)
+  double build_ms = 0.0;                      // the two-level path's commits
   DeviceScene shading;
   cl::Kernel shade, accumulate;
   // Moving scenes: the ray-time kernels and the queue's and shadow queue's times.
@@ -91,6 +94,8 @@ struct Renderer::State {
   // Per generation: queue -> hits -> radiance + slots -> next queue + shadow queue.
   RayQueue queue, next;
   GrowingBuffer hits{"hits", sizeof(Hit)}, radiance{"path radiance", RTCL_RADIANCE_BYTES};
+  GrowingBuffer hit_objects{"hit objects", sizeof(cl_uint)};  // the two-level path: each hit's object
+  std::vector<std::uint32_t> first_objects;  // render_pixels on the two-level path: the first hits' objects
   SpawnSlots spawn;
   ShadowSlots shadow_slots;
   ShadowQueue shadows;
@@ -103,12 +108,20 @@ struct Renderer::State {
   std::vector<std::pair<cl::Event, cl::Event>> compacts;  // first and last kernel of both compactions
 
   State(const Device& d, const SceneDescription& s) : device(d), scene(s), queue(d), next(d), shadows(d) {}
+  // Whether rays carry times (moving objects on either path).
+  bool timed() const { return motion || (instanced && instanced->moving()); }
 };
 
 Renderer::Renderer(const Device& device, const SceneDescription& scene, std::string_view accel_name, const AccelConfig& config,
                    MotionBounds motion_bounds)
     : s_(std::make_unique<State>(device, scene)) {
-  if (!scene_moves(scene)) {
+  if (shares_meshes(scene)) {
+    auto start = std::chrono::steady_clock::now();
+    s_->instanced = std::make_unique<InstancedScene>(device, scene, accel_name, config);
+    s_->build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    s_->scene.lights = instanced_lights(scene);
+    s_->shading = upload_instanced_scene(device, s_->scene, *s_->instanced);
+  } else if (!scene_moves(scene)) {
     s_->flat = flatten(scene);
     s_->scene.lights = expand_emissive_lights(scene, s_->flat);
     s_->accel = make_accel(device, accel_name, s_->flat.geometry, config);
@@ -131,6 +144,8 @@ Renderer::Renderer(const Device& device, const SceneDescription& scene, std::str
                     "emissive must not move)");
     s_->motion = std::make_unique<MotionBvh>(device, s_->flat.geometry, end.geometry, motion_bounds, config);
     s_->shading = upload_scene(device, s_->scene, s_->flat, &end);
+  }
+  if (s_->timed()) {
     with_cl_errors([&] {
       cl::Program program = device.program("render/ray_times.cl", {});
       s_->queue_times = cl::Kernel(program, "queue_ray_times");
@@ -151,7 +166,31 @@ Renderer::Renderer(const Device& device, const SceneDescription& scene, std::str
 Renderer::~Renderer() = default;
 
 const RenderStats& Renderer::stats() const { return s_->stats; }
-const Accel& Renderer::accel() const { return s_->accel ? *s_->accel : *s_->motion; }
+const Accel& Renderer::accel() const {
+  if (s_->instanced)
+    throw Error("Renderer::accel: " + s_->scene.source + " is traced through two levels (Renderer::scene), not one Accel");
+  return s_->accel ? *s_->accel : *s_->motion;
+}
+bool Renderer::instanced() const { return s_->instanced != nullptr; }
+const Scene* Renderer::scene() const { return s_->instanced ? &s_->instanced->scene() : nullptr; }
+std::size_t Renderer::shading_bytes() const {
+  if (s_->instanced) return s_->instanced->shading_bytes();
+  const std::size_t t = std::max<std::uint32_t>(s_->shading.triangle_count, 1), sp = std::max<std::uint32_t>(s_->shading.sphere_count, 1);
+  return (t * sizeof(ShadeTriangle) + sp * sizeof(ShadeSphere)) * (s_->motion ? 2 : 1);
+}
+double Renderer::build_ms() const { return s_->instanced ? s_->build_ms : accel().stats().build_ms; }
+
+CommitStats Renderer::set_shutter(float open, float close) {
+  if (!s_->instanced)
+    throw Error("Renderer::set_shutter: " + s_->scene.source +
+                " is traced by the flat path; a new shutter needs a new Renderer");
+  auto start = std::chrono::steady_clock::now();
+  CommitStats stats = s_->instanced->set_shutter(open, close);
+  s_->build_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  s_->scene.camera.shutter_open = open;
+  s_->scene.camera.shutter_close = close;
+  return stats;
+}
 const std::vector<std::string>& Renderer::defines() const { return s_->shading.defines; }
 
 // Per render: camera, shading constants, a cleared framebuffer.
@@ -288,7 +327,10 @@ PixelSamples Renderer::render_pixels(const RenderSettings& settings, const std::
         const Hit& h = hits[i];
         const bool hit = h.prim >= 0;
         out.depth[slot / settings.spp] = hit ? h.t : INFINITY;
-        out.object[slot / settings.spp] = hit ? static_cast<std::int32_t>(s.flat.material.at(std::size_t(h.prim))) : -1;
+        const std::uint32_t material = !hit ? 0u
+                                       : s.instanced ? s.instanced->material(s.first_objects.at(i), h.prim)
+                                                     : s.flat.material.at(std::size_t(h.prim));
+        out.object[slot / settings.spp] = hit ? static_cast<std::int32_t>(material) : -1;
       }
     }
   } catch (...) {
@@ -320,6 +362,12 @@ void Renderer::trace_batch(std::uint32_t count, double done, double total_work, 
       with_cl_errors([&] {
         s.device.queue().enqueueReadBuffer(s.hits.buffer(), CL_TRUE, 0, first_hits->size() * sizeof(Hit),
                                            first_hits->data(), wait_list(s.last));
+        if (s.instanced) {
+          s.first_objects.resize(first_hits->size());
+          s.device.queue().enqueueReadBuffer(s.hit_objects.buffer(), CL_TRUE, 0,
+                                             s.first_objects.size() * sizeof(cl_uint), s.first_objects.data(),
+                                             wait_list(s.last));
+        }
       });
     }
     advance_generation();
@@ -400,6 +448,15 @@ void Renderer::trace(bool camera_rays) {
   s.stats.peak_queue = std::max(s.stats.peak_queue, n);
   const cl::Buffer& hits = s.hits.reserve(s.device, n);
   Coherence coherence = camera_rays ? Coherence::coherent : Coherence::incoherent;
+  if (s.instanced) {
+    SceneBuffers extra;
+    extra.instance_ids = s.hit_objects.reserve(s.device, n);
+    if (s.instanced->moving()) extra.times = s.times.buffer();
+    cl::Event e = s.instanced->scene().trace(Query::closest, s.queue.rays(), hits, n, extra, s.last, coherence);
+    (camera_rays ? s.camera_traces : s.secondary_traces).push_back(e);
+    s.last = {e};
+    return;
+  }
   cl::Event e = s.motion ? s.motion->trace(Query::closest, s.queue.rays(), RayTimes{s.times.buffer()}, hits, n, s.last, coherence)
                          : s.accel->trace(Query::closest, s.queue.rays(), hits, n, s.last, coherence);
   (camera_rays ? s.camera_traces : s.secondary_traces).push_back(e);
@@ -443,6 +500,10 @@ void Renderer::shade() {
       k.setArg(a++, s.shading.spheres_close);
     }
     if (s.slots) k.setArg(a++, s.pixel_list);
+    if (s.instanced) {
+      k.setArg(a++, s.instanced->instances());
+      k.setArg(a++, s.hit_objects.buffer());
+    }
     cl::Event e = launch(s.device, k, n, s.last);
     s.shades.push_back(e);
     s.last = {e};
@@ -475,6 +536,15 @@ void Renderer::compact() {
 void Renderer::trace_shadows() {
   State& s = *s_;
   if (s.shadows.size() == 0) return;
+  if (s.instanced) {
+    SceneBuffers extra;
+    if (s.instanced->moving()) extra.times = s.shadow_time.buffer();
+    cl::Event e = s.instanced->scene().trace(Query::any, s.shadows.rays(), s.shadows.hits(), s.shadows.size(), extra,
+                                             s.last, Coherence::coherent);
+    s.shadow_traces.push_back(e);
+    s.last = {e};
+    return;
+  }
   cl::Event e = s.motion ? s.motion->trace(Query::any, s.shadows.rays(), RayTimes{s.shadow_time.buffer()},
                                            s.shadows.hits(), s.shadows.size(), s.last, Coherence::coherent)
                          : s.accel->trace(Query::any, s.shadows.rays(), s.shadows.hits(), s.shadows.size(), s.last,
@@ -487,7 +557,7 @@ void Renderer::trace_shadows() {
 // pixel and the sample being traced.
 void Renderer::queue_times() {
   State& s = *s_;
-  if (!s.motion) return;
+  if (!s.timed()) return;
   std::size_t n = s.queue.size();
   s.times.reserve(s.device, std::max<std::size_t>(n, 1));
   with_cl_errors([&] {
@@ -514,7 +584,7 @@ void Renderer::queue_times() {
 // whose hit cast it.
 void Renderer::shadow_times() {
   State& s = *s_;
-  if (!s.motion || s.shadows.size() == 0) return;
+  if (!s.timed() || s.shadows.size() == 0) return;
   s.shadow_time.reserve(s.device, s.shadows.size());
   with_cl_errors([&] {
     cl::Kernel& k = s.shadow_times;

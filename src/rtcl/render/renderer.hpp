@@ -26,6 +26,7 @@
 #include "rtcl/render/image.hpp"
 #include "rtcl/render/render_layouts.hpp"
 #include "rtcl/render/sampling_options.hpp"
+#include "rtcl/scene.hpp"
 #include "rtcl/scene/scene_description.hpp"
 
 namespace rtcl {
@@ -108,7 +109,11 @@ class Renderer {
   // camera's shutter open and close and traced by the MotionBvh with
   // `motion_bounds` (accel_name must then be "bvh"; the kernels get
   // RTCL_HAS_MOTION and each ray its sample's time); a static scene has no
-  // time code. Throws Error.
+  // time code. A scene whose meshes share a shape (shares_meshes) takes
+  // the two-level path instead (instanced(): an rtcl::Scene with each shape
+  // built once, docs/scenes-and-instances.md); accel_name must then name a
+  // structure of the BVH family, and moving objects are moving instances
+  // (motion_bounds unused). Throws Error.
   Renderer(const Device& device, const SceneDescription& scene, std::string_view accel_name, const AccelConfig& config = {},
            MotionBounds motion_bounds = MotionBounds::interpolated);
   ~Renderer();
@@ -150,7 +155,27 @@ class Renderer {
   std::vector<std::vector<TreeRay>> ray_tree(const Ray& ray, const RenderSettings& settings);
 
   const RenderStats& stats() const;          // of the last render
-  const Accel& accel() const;  // the MotionBvh when the scene moves
+  // The flat path's structure (the MotionBvh when the scene moves); Error
+  // on the two-level path.
+  const Accel& accel() const;
+  // Whether the scene is traced through two levels; its Scene then (null
+  // on the flat path): SceneStats counts the bottom levels built and the
+  // device bytes of the structure.
+  bool instanced() const;
+  const Scene* scene() const;
+  // Device bytes of the shading records (triangles, spheres and, on the
+  // two-level path, one ShadeInstance per object).
+  std::size_t shading_bytes() const;
+  // Host build time of the structure (the Scene's commits on the two-level path).
+  double build_ms() const;
+  // Animations on the two-level path: the camera's shutter becomes [open,
+  // close] (keyframe times) and each moving object is placed for it: its
+  // transforms at open and close, committed (the top level is rebuilt,
+  // never a bottom level). The same images as a Renderer built anew for
+  // that shutter. Throws Error on the flat path (build a new Renderer) or
+  // for a shutter that check_motion refuses; the renderer then stays as
+  // it was.
+  CommitStats set_shutter(float open, float close);
   const std::vector<std::string>& defines() const;  // the shade kernel's -D options
 
  private:

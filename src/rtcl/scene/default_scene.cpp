@@ -40,7 +40,7 @@ std::vector<Material> materials() {
 
 // Appends the quad a b c d (a convex polygon in order) as two triangles,
 // wound so that their normal points along `outward`.
-void add_quad(SceneMesh& mesh, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 outward,
+void add_quad(MeshShape& mesh, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 outward,
               std::uint32_t material) {
   if (glm::dot(glm::cross(b - a, c - a), outward) < 0.0f) std::swap(b, d);
   auto base = static_cast<std::uint32_t>(mesh.vertices.size());
@@ -51,8 +51,9 @@ void add_quad(SceneMesh& mesh, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 
 }
 
 SceneMesh room() {
-  SceneMesh m;
-  m.name = "room";
+  SceneMesh out;
+  out.name = "room";
+  MeshShape& m = out.edit_shape();
   const glm::vec3 up(0, 1, 0), right(1, 0, 0), front(0, 0, 1);
   // Faces point into the room (the side the camera sees).
   add_quad(m, {-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}, up, white);      // floor
@@ -62,13 +63,14 @@ SceneMesh room() {
   add_quad(m, {1, 0, -1}, {1, 0, 1}, {1, 2, 1}, {1, 2, -1}, -right, green);    // right wall
   const float h = 1.995f, s = 0.25f;
   add_quad(m, {-s, h, -s}, {s, h, -s}, {s, h, s}, {-s, h, s}, -up, panel);      // light panel
-  return m;
+  return out;
 }
 
 // A unit cube [-0.5, 0.5]^3 with outward faces; placed by its transform.
 SceneMesh glass_block() {
-  SceneMesh m;
-  m.name = "glass block";
+  SceneMesh out;
+  out.name = "glass block";
+  MeshShape& m = out.edit_shape();
   for (int axis = 0; axis < 3; ++axis)
     for (float side : {-0.5f, 0.5f}) {
       glm::vec3 n(0.0f), u(0.0f), v(0.0f);
@@ -81,8 +83,8 @@ SceneMesh glass_block() {
   // make the closest hit between block and floor arbitrary).
   glm::dmat4 t = glm::translate(glm::dmat4(1.0), glm::dvec3(0.42, 0.402, -0.45));
   t = glm::rotate(t, glm::radians(25.0), glm::dvec3(0, 1, 0));
-  m.transform = glm::scale(t, glm::dvec3(0.4, 0.8, 0.4));
-  return m;
+  out.transform = glm::scale(t, glm::dvec3(0.4, 0.8, 0.4));
+  return out;
 }
 
 }  // namespace

@@ -2,6 +2,8 @@
 
 #include <cstdint>
 #include <cstring>
+#include <map>
+#include <memory>
 #include <string>
 #include <type_traits>
 
@@ -12,7 +14,7 @@ namespace rtcl {
 namespace {
 
 constexpr std::uint32_t magic = 0x6c637472u;  // "rtcl"
-constexpr std::uint32_t version = 2;  // 2: roughness, motion keyframes
+constexpr std::uint32_t version = 3;  // 2: roughness, motion keyframes; 3: shared mesh shapes
 
 class Writer {
  public:
@@ -106,12 +108,23 @@ std::vector<std::byte> scene_to_bytes(const SceneDescription& scene) {
     w.pod(m.ior);
     w.pod(m.roughness);
   }
+  // Each shape once, in the order of its first mesh; each mesh names its
+  // shape by that order, so meshes that share a shape share it after
+  // decoding too.
+  std::map<const MeshShape*, std::uint64_t> shape_index;
+  std::vector<const MeshShape*> shapes;
+  for (const SceneMesh& m : scene.meshes)
+    if (shape_index.try_emplace(m.shape.get(), shapes.size()).second) shapes.push_back(m.shape.get());
+  w.pod(std::uint64_t(shapes.size()));
+  for (const MeshShape* shape : shapes) {
+    w.array(shape->vertices);
+    w.array(shape->triangles);
+    w.array(shape->materials);
+  }
   w.pod(std::uint64_t(scene.meshes.size()));
   for (const SceneMesh& m : scene.meshes) {
     w.text(m.name);
-    w.array(m.vertices);
-    w.array(m.triangles);
-    w.array(m.materials);
+    w.pod(shape_index.at(m.shape.get()));
     w.pod(m.transform);
     w.pod(std::uint8_t(m.end_transform.has_value()));
     if (m.end_transform) w.pod(*m.end_transform);
@@ -157,12 +170,20 @@ SceneDescription scene_from_bytes(std::span<const std::byte> bytes, const std::s
     m.ior = r.pod<float>();
     m.roughness = r.pod<float>();
   }
+  std::vector<std::shared_ptr<const MeshShape>> shapes(r.count());
+  for (std::shared_ptr<const MeshShape>& shape : shapes) {
+    auto made = std::make_shared<MeshShape>();
+    made->vertices = r.array<glm::vec3>();
+    made->triangles = r.array<glm::uvec3>();
+    made->materials = r.array<std::uint32_t>();
+    shape = std::move(made);
+  }
   scene.meshes.resize(r.count());
   for (SceneMesh& m : scene.meshes) {
     m.name = r.text();
-    m.vertices = r.array<glm::vec3>();
-    m.triangles = r.array<glm::uvec3>();
-    m.materials = r.array<std::uint32_t>();
+    auto shape = r.pod<std::uint64_t>();
+    if (shape >= shapes.size()) r.fail("mesh shape " + std::to_string(shape) + " of " + std::to_string(shapes.size()));
+    m.shape = shapes[shape];
     m.transform = r.pod<glm::dmat4>();
     if (r.pod<std::uint8_t>()) m.end_transform = r.pod<glm::dmat4>();
     m.motion_key = r.text();

@@ -14,7 +14,8 @@
 namespace rtcl {
 
 // Every field of the scene, in declaration order; floats and doubles bit
-// for bit.
+// for bit. Mesh shapes go once each, before the meshes that name them by
+// index: meshes that share a shape share it after scene_from_bytes too.
 std::vector<std::byte> scene_to_bytes(const SceneDescription& scene);
 
 // The scene scene_to_bytes encoded. Throws Error naming `what` (where the

@@ -1,6 +1,7 @@
 #include "rtcl/scene/scene_description.hpp"
 
 #include <cmath>
+#include <unordered_set>
 
 #include "rtcl/error.hpp"
 
@@ -90,10 +91,13 @@ void validate(const SceneDescription& scene) {
   check_colour(scene, "background", scene.background);
   for (std::size_t i = 0; i < scene.lights.size(); ++i) validate_light(scene, i);
   for (std::size_t i = 0; i < scene.materials.size(); ++i) validate_material(scene, i);
+  std::unordered_set<const MeshShape*> checked;
   for (const SceneMesh& mesh : scene.meshes) {
-    if (mesh.materials.size() != mesh.triangles.size())
+    if (!mesh.shape) throw Error(scene.source + ": mesh " + mesh.name + ": no shape");
+    if (!checked.insert(mesh.shape.get()).second) continue;
+    if (mesh.materials().size() != mesh.triangles().size())
       throw Error(scene.source + ": mesh " + mesh.name + ": one material per triangle expected");
-    for (std::uint32_t m : mesh.materials)
+    for (std::uint32_t m : mesh.materials())
       if (m >= scene.materials.size())
         throw Error(scene.source + ": mesh " + mesh.name + ": material index " + std::to_string(m) + " out of range");
   }
@@ -107,6 +111,19 @@ void validate(const SceneDescription& scene) {
   if (scene.meshes.empty() && scene.spheres.empty()) throw Error(scene.source + ": the scene has no mesh and no sphere");
 }
 
+bool shares_meshes(const SceneDescription& scene) {
+  std::unordered_set<const MeshShape*> seen;
+  for (const SceneMesh& mesh : scene.meshes)
+    if (!seen.insert(mesh.shape.get()).second) return true;
+  return false;
+}
+
+SceneDescription unshare_meshes(const SceneDescription& scene) {
+  SceneDescription out = scene;
+  for (SceneMesh& mesh : out.meshes) mesh.edit_shape();
+  return out;
+}
+
 FlatScene flatten(const SceneDescription& scene) {
   validate(scene);
   FlatScene flat;
@@ -116,12 +133,12 @@ FlatScene flatten(const SceneDescription& scene) {
     // A mirroring transform reverses the winding: swap two corners so that
     // faces keep facing outward (refraction tells inside from outside by it).
     bool mirrored = glm::determinant(glm::dmat3(mesh.transform)) < 0.0;
-    for (const glm::vec3& v : mesh.vertices) flat.geometry.vertices.push_back(apply_point(mesh.transform, v));
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      glm::uvec3 tri = mesh.triangles[t] + glm::uvec3(base);
+    for (const glm::vec3& v : mesh.vertices()) flat.geometry.vertices.push_back(apply_point(mesh.transform, v));
+    for (std::size_t t = 0; t < mesh.triangles().size(); ++t) {
+      glm::uvec3 tri = mesh.triangles()[t] + glm::uvec3(base);
       if (mirrored) std::swap(tri.y, tri.z);
       flat.geometry.triangles.push_back(tri);
-      flat.material.push_back(mesh.materials[t]);
+      flat.material.push_back(mesh.materials()[t]);
     }
   }
   for (const SceneSphere& s : scene.spheres) {

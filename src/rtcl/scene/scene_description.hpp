@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -79,12 +80,21 @@ struct Camera {
   float shutter_open = 0.0f, shutter_close = 1.0f;
 };
 
-// A triangle mesh in object space with its object-to-world transform.
-struct SceneMesh {
-  std::string name;  // the file path or a built-in name: named in errors
+// A triangle mesh's data in object space. Scene objects that load the same
+// mesh file with the same material assignment share one MeshShape (a
+// std::shared_ptr): the renderer then builds it once and places it by
+// instances (docs/scenes-and-instances.md, "Scene files and the renderer").
+struct MeshShape {
   std::vector<glm::vec3> vertices;
   std::vector<glm::uvec3> triangles;
   std::vector<std::uint32_t> materials;  // one per triangle, index into SceneDescription::materials
+};
+
+// A triangle mesh: its shape (object space, possibly shared with other
+// meshes) and its object-to-world transform.
+struct SceneMesh {
+  std::string name;  // the file path or a built-in name: named in errors
+  std::shared_ptr<const MeshShape> shape = std::make_shared<const MeshShape>();  // never null
   glm::dmat4 transform{1.0};             // object to world; a mirroring one keeps faces outward
   // Motion: the object-to-world transform at keyframe time 1 (`transform`
   // is keyframe 0); at time t the transform is the blend (1 - t) * transform
@@ -92,6 +102,19 @@ struct SceneMesh {
   // constant speed, beyond [0, 1] too (rtcl/scene/motion.hpp). None: static.
   std::optional<glm::dmat4> end_transform;
   std::string motion_key;  // where the motion was given ("scene.json: objects[2].motion"): named in errors
+
+  // The shape's data (shorthands).
+  const std::vector<glm::vec3>& vertices() const { return shape->vertices; }
+  const std::vector<glm::uvec3>& triangles() const { return shape->triangles; }
+  const std::vector<std::uint32_t>& materials() const { return shape->materials; }
+  // This mesh's own copy of its shape to change: the shape is copied first,
+  // so the meshes that shared it keep theirs.
+  MeshShape& edit_shape() {
+    auto copy = std::make_shared<MeshShape>(*shape);
+    MeshShape& out = *copy;
+    shape = std::move(copy);
+    return out;
+  }
 };
 
 // A sphere in world space (spheres are transformed when loaded).
@@ -142,6 +165,13 @@ struct SceneDescription {
 // ior <= 0, a negative shininess, a material index out of range, a non-finite number anywhere,
 // or a scene with no mesh and no sphere.
 void validate(const SceneDescription& scene);
+
+// Whether some MeshShape is the shape of more than one mesh: the renderer
+// then traces the scene through instances (Renderer).
+bool shares_meshes(const SceneDescription& scene);
+// The scene with every mesh holding its own copy of its shape (no sharing):
+// the same image through the renderer's flat path.
+SceneDescription unshare_meshes(const SceneDescription& scene);
 
 // The world-space primitives: mesh triangles in mesh order (transformed in
 // double, rounded to float), then spheres; material[prim] for every

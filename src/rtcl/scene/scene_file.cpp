@@ -355,7 +355,8 @@ class SceneBuilder {
     std::string file_at = Reader::join(where, "file");
     std::string file = r_.string(r_.required(v, where, "file"), file_at);
     std::filesystem::path path = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : base_dir_ / file;
-    const LoadedMesh& loaded = load(path.lexically_normal().string(), file_at);
+    const std::string key = path.lexically_normal().string();
+    const LoadedMesh& loaded = load(key, file_at);
 
     // Per MTL material: the scene material it maps to.
     std::vector<std::uint32_t> map(loaded.materials.size());
@@ -378,7 +379,11 @@ class SceneBuilder {
       if (all) map[i] = *all;
       else if (auto it = overrides.find(mm.name); it != overrides.end()) map[i] = it->second;
       else {
-        map[i] = static_cast<std::uint32_t>(scene_.materials.size());
+        // The file's own material: one scene material per file and MTL
+        // material, whichever objects load the file.
+        auto [made, added] = mtl_materials_.try_emplace({key, i}, static_cast<std::uint32_t>(scene_.materials.size()));
+        map[i] = made->second;
+        if (!added) continue;
         Material m = material_from_mtl(mm);
         m.name = mm.name + " (" + file + ")";
         scene_.materials.push_back(m);
@@ -387,10 +392,17 @@ class SceneBuilder {
 
     SceneMesh mesh;
     mesh.name = path.string();
-    mesh.vertices = loaded.geometry.vertices;
-    mesh.triangles = loaded.geometry.triangles;
-    mesh.materials.reserve(loaded.triangle_material.size());
-    for (std::uint32_t m : loaded.triangle_material) mesh.materials.push_back(map.at(m));
+    // Objects that load the same file with the same materials share its shape.
+    std::shared_ptr<const MeshShape>& shape = shapes_[{key, map}];
+    if (!shape) {
+      auto made = std::make_shared<MeshShape>();
+      made->vertices = loaded.geometry.vertices;
+      made->triangles = loaded.geometry.triangles;
+      made->materials.reserve(loaded.triangle_material.size());
+      for (std::uint32_t m : loaded.triangle_material) made->materials.push_back(map.at(m));
+      shape = std::move(made);
+    }
+    mesh.shape = shape;
     if (v.contains("transform")) mesh.transform = read_transform(r_, v["transform"], Reader::join(where, "transform"));
     if (v.contains("motion")) {
       std::string at = Reader::join(where, "motion");
@@ -417,6 +429,10 @@ class SceneBuilder {
   SceneDescription scene_;
   std::map<std::string, std::uint32_t> named_;
   std::map<std::string, LoadedMesh> meshes_;
+  // The scene material made for (file, its MTL material index).
+  std::map<std::pair<std::string, std::size_t>, std::uint32_t> mtl_materials_;
+  // The shape of (file, scene material per MTL material).
+  std::map<std::pair<std::string, std::vector<std::uint32_t>>, std::shared_ptr<const MeshShape>> shapes_;
 };
 
 }  // namespace

@@ -18,18 +18,22 @@ struct Emitters {
 // channel and a non-zero area.
 Emitters emitters_of(const SceneDescription& scene) {
   Emitters out;
-  for (const SceneMesh& mesh : scene.meshes)
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      const glm::vec3 emission = scene.materials[mesh.materials[t]].emission;
+  auto emits = [&](std::uint32_t m) { return glm::any(glm::greaterThan(scene.materials[m].emission, glm::vec3(0.0f))); };
+  for (const SceneMesh& mesh : scene.meshes) {
+    const MeshShape& shape = *mesh.shape;
+    if (std::none_of(shape.materials.begin(), shape.materials.end(), emits)) continue;
+    for (std::size_t t = 0; t < shape.triangles.size(); ++t) {
+      const glm::vec3 emission = scene.materials[shape.materials[t]].emission;
       if (!glm::any(glm::greaterThan(emission, glm::vec3(0.0f)))) continue;
       glm::dvec3 v[3];
-      for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(mesh.transform * glm::dvec4(glm::dvec3(mesh.vertices[mesh.triangles[t][k]]), 1.0));
+      for (int k = 0; k < 3; ++k) v[k] = glm::dvec3(mesh.transform * glm::dvec4(glm::dvec3(shape.vertices[shape.triangles[t][k]]), 1.0));
       const double area = 0.5 * glm::length(glm::cross(v[1] - v[0], v[2] - v[0]));
       if (!(area > 0.0)) continue;
       ++out.triangles;
       out.area += area;
       out.emission_times_area += glm::dvec3(emission) * area;
     }
+  }
   return out;
 }
 

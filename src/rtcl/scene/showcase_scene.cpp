@@ -2,6 +2,7 @@
 
 #include "rtcl/error.hpp"
 #include "rtcl/scene/default_scene.hpp"
+#include "rtcl/scene/forest_scene.hpp"
 
 namespace rtcl {
 
@@ -63,10 +64,16 @@ SceneDescription showcase_scene() {
   return s;
 }
 
-SceneDescription builtin_scene(const std::string& name) {
+SceneDescription builtin_scene(const std::string& name, const std::string& scenes_dir) {
   if (name == "default") return default_scene();
   if (name == "showcase") return showcase_scene();
-  throw Error("builtin_scene name \"" + name + "\": unknown built-in scene (known: default, showcase)");
+  if (name == "forest") {
+    if (scenes_dir.empty())
+      throw Error("builtin_scene name \"forest\": the forest reads the Stanford bunny from the scenes directory "
+                  "(stanford_bunny/bunny.obj in it), and none is given (RTCL_SCENES_DIR names it)");
+    return forest_scene(scenes_dir + "/stanford_bunny/bunny.obj");
+  }
+  throw Error("builtin_scene name \"" + name + "\": unknown built-in scene (known: default, showcase, forest)");
 }
 
 }  // namespace rtcl

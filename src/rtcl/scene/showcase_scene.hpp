@@ -13,8 +13,10 @@ namespace rtcl {
 
 SceneDescription showcase_scene();
 
-// The built-in scenes by name: "default", "showcase". Throws Error
-// (builtin_scene name "NAME": ...) naming the known names for another.
-SceneDescription builtin_scene(const std::string& name);
+// The built-in scenes by name: "default", "showcase", "forest" (its bunny
+// from `scenes_dir`/stanford_bunny/bunny.obj, rtcl/scene/forest_scene.hpp).
+// Throws Error (builtin_scene name "NAME": ...) naming the known names for
+// another, or for the forest without a scenes directory.
+SceneDescription builtin_scene(const std::string& name, const std::string& scenes_dir = "");
 
 }  // namespace rtcl
