@@ -20,6 +20,9 @@ packages=(
 if [ "$render_only" -eq 0 ]; then
   packages+=(
     openimageio-tools libgtest-dev libgmock-dev libbenchmark-dev libembree-dev python3 python3-matplotlib
+    # Assimp's own test models: every OBJ, PLY and STL of them loads, or
+    # Assimp agrees it has no triangles (tests/assimp_testmodels_test.cpp)
+    assimp-testmodels
     # the Python module (python/, CMake option RTCL_PYTHON) and its tests;
     # python3-open3d is the tests' reference for point queries and camera rays
     python3-dev python3-numpy pybind11-dev python3-pytest python3-open3d

@@ -45,6 +45,29 @@ TEST(MeshPrecheck, MalformedFilesNameWhatTheyDeclare) {
             std::string::npos);
 }
 
+// Assimp 5.2 skips header lines it does not know (Blender writes "Created
+// by Blender3D ..." without "comment"), and ends an element's properties at
+// the first other line, ignoring property lines after it.
+TEST(MeshPrecheck, UnknownHeaderLinesAreSkippedAsAssimpSkipsThem) {
+  const std::string body = "0 0 0 1 0 0 0 1 0 3 0 1 2";
+  const std::string blender =
+      "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org, source file: \nproperty float w\n"
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nobj_info o\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  EXPECT_EQ(error_of([&] { check_declared_sizes("a.ply", ".ply", blender + body); }), "");
+  // the skipped lines declare nothing: the sizes are still checked
+  std::string e = error_of([&] { check_declared_sizes("a.ply", ".ply", blender + "0 0 0 1 0 0 0 1 0 3 0 1"); });
+  EXPECT_NE(e.find("a.ply: PLY element 'face' 0 of 1: a list declares 3 entries"), std::string::npos) << e;
+  for (const char* between : {"comment c\n", "obj_info o\n", "Created by x\n"}) {
+    std::string split = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n" + std::string(between) +
+                        "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+    e = error_of([&] { check_declared_sizes("a.ply", ".ply", split); });
+    EXPECT_NE(e.find("a.ply: PLY header line 6: a property of element 'vertex' after a line that is not a property"),
+              std::string::npos)
+        << between << ": " << e;
+  }
+}
+
 TEST(MeshPrecheck, MaterialLibrariesAsAssimpNamesThem) {
   EXPECT_EQ(obj_material_libraries("v 0 0 0\nmtllib a.mtl\r\nmtllib\t my file.mtl \t\nmtllib\n# mtllib c.mtl\n"
                                    "  mtllib indented.mtl\nmtllibx x.mtl\n"),

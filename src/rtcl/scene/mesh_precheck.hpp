@@ -14,10 +14,12 @@ namespace rtcl {
 // Throws Error naming `path`, the declared size and the available bytes when
 // `bytes` (the whole file) cannot hold what it declares:
 // - any file: empty;
-// - PLY (ASCII or binary): a header that is not exactly the documented
-//   keywords and types (Assimp can loop forever on some), an element count,
-//   or a list length of any element instance, that needs more bytes than
-//   remain (truncated data included);
+// - PLY (ASCII or binary): a header without end_header (Assimp 5.2 can loop
+//   forever on one), a malformed format, element or property line, a
+//   property after a line that ended its element's property list (Assimp
+//   would ignore it), an element count, or a list length of any element
+//   instance, that needs more bytes than remain (truncated data included);
+//   lines with unknown keywords are skipped, as Assimp skips them;
 // - binary STL (a file not starting with "solid"): a size other than the
 //   84 + 50 * triangle_count bytes its header declares.
 // `extension` is lower case with its dot (".ply").
