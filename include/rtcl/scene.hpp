@@ -95,8 +95,8 @@ struct MeshOptions {
 struct CommitStats {
   std::size_t bottom_levels_built = 0;     // meshes built (new) or rebuilt (vertices updated)
   std::size_t bottom_levels_refitted = 0;  // meshes whose vertices moved and whose trees were refitted
-  bool top_level_built = false;            // instances added, removed or changed, or a mesh's tree
-  double build_ms = 0.0;                // host builds and uploads of this commit
+  bool top_level_built = false;            // instances added, removed or changed, or a bottom level
+  double build_ms = 0.0;                   // host builds, refits and uploads of this commit
 };
 
 struct SceneStats {
@@ -166,9 +166,10 @@ class Scene {
 
   // Builds the bottom levels of meshes added since the last commit, refits
   // or rebuilds those updated and, when instances were added, removed or
-  // changed or a placed mesh moved, the top level (a BVH over the
-  // instances' world boxes), uploads them and makes them what queries see. On an exception the scene stays as it was: the
-  // previous commit answers queries and the edits stay pending.
+  // changed or a bottom level changed, the top level (a BVH over the
+  // instances' world boxes), uploads them and makes them what queries see.
+  // On an exception the scene stays as it was: the previous commit answers
+  // queries and the edits stay pending.
   CommitStats commit();
 
   // ---- Queries (of the last commit) ---------------------------------------
