@@ -27,8 +27,10 @@
  * atomic increment; the finishing work-item fences after its increment and
  * reads the node's lanes through a volatile pointer, so that a device
  * whose caches are not coherent between compute units reads them from
- * global memory (the classic bottom-up refit; OpenCL 1.2 promises nothing
- * between work-groups, every device rtcl runs on orders memory this way).
+ * global memory. This is the classic bottom-up refit of GPU BVH builders;
+ * OpenCL 1.2 promises no order between work-groups, so it relies on the
+ * device's global fences and atomics ordering memory, as a CPU device's
+ * coherent caches do and GPUs' fences do in practice.
  *
  * Boxes are the exact float minima and maxima of the corners (no
  * rounding), so every lane's box contains what lies below it. cost_parts[n]
