@@ -116,14 +116,16 @@ TEST(Scene, CommitBuildsOnlyWhatChanged) {
   std::vector<float> xyz;
   for (const glm::vec3& v : a.vertices) xyz.insert(xyz.end(), {v.x, v.y, v.z + 0.5f});
   scene.update_vertices(ma, xyz);
-  CommitStats updated = scene.commit();
-  EXPECT_EQ(updated.bottom_levels_built, 1u);
+  CommitStats updated = scene.commit();  // moved as a whole: its tree is refitted
+  EXPECT_EQ(updated.bottom_levels_built, 0u);
+  EXPECT_EQ(updated.bottom_levels_refitted, 1u);
   EXPECT_TRUE(updated.top_level_built);
 
   SceneStats s = scene.stats();
   EXPECT_EQ(s.meshes, 2u);
   EXPECT_EQ(s.instances, 21u);
-  EXPECT_EQ(s.bottom_levels_built, 3u);
+  EXPECT_EQ(s.bottom_levels_built, 2u);
+  EXPECT_EQ(s.bottom_levels_refitted, 1u);
   EXPECT_EQ(s.top_levels_built, 3u);
 }
 

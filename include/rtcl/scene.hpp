@@ -83,19 +83,27 @@ struct Instance {
 struct MeshOptions {
   std::string structure = "bvh";
   AccelOptions options;  // applied after the spec's, as AccelConfig::options
+  // What the commit after update_vertices does: refits the mesh's tree
+  // under this policy (rtcl/accel.hpp; Accel::refit's rules: rebuilt
+  // instead when a triangle skipped at the build for zero area has an area
+  // now, or when the refitted tree's SAH cost passes max_cost_ratio times
+  // the cost at its last build). None: rebuilds it at every update.
+  std::optional<RefitPolicy> refit = RefitPolicy{};
 };
 
 // What one commit() did.
 struct CommitStats {
-  std::size_t bottom_levels_built = 0;  // meshes built (new) or rebuilt (vertices updated)
-  bool top_level_built = false;         // instances added, removed or changed
-  double build_ms = 0.0;                // host builds and uploads of this commit
+  std::size_t bottom_levels_built = 0;     // meshes built (new) or rebuilt (vertices updated)
+  std::size_t bottom_levels_refitted = 0;  // meshes whose vertices moved and whose trees were refitted
+  bool top_level_built = false;            // instances added, removed or changed, or a bottom level
+  double build_ms = 0.0;                   // host builds, refits and uploads of this commit
 };
 
 struct SceneStats {
   std::size_t meshes = 0;                 // committed
   std::size_t instances = 0;              // committed
   std::size_t bottom_levels_built = 0;    // over every commit so far
+  std::size_t bottom_levels_refitted = 0; // over every commit so far
   std::size_t top_levels_built = 0;       // over every commit so far
   std::size_t device_bytes = 0;           // bottom levels, instances and top level on the device
   bool single_level = false;              // the committed scene is one static identity instance
@@ -136,7 +144,8 @@ class Scene {
   MeshId add_mesh(const Geometry& geometry, const MeshOptions& options = {});
   // New vertex positions for the mesh's triangles (3 floats per vertex, the
   // mesh's vertex count); the triangles and spheres stay. The next commit
-  // rebuilds its bottom level.
+  // refits its bottom level (the same tree, new boxes), or rebuilds it where
+  // the mesh's MeshOptions::refit says so (CommitStats counts either).
   void update_vertices(MeshId mesh, std::span<const float> xyz);
   // Removes a mesh that no instance uses (an Error names the instances that
   // still do).
@@ -155,11 +164,12 @@ class Scene {
   // The instance as last set (pending edits included).
   Instance instance(InstanceId id) const;
 
-  // Builds the bottom levels of meshes added or updated since the last
-  // commit and, when instances were added, removed or changed, the top
-  // level (a BVH over the instances' world boxes), uploads them and makes
-  // them what queries see. On an exception the scene stays as it was: the
-  // previous commit answers queries and the edits stay pending.
+  // Builds the bottom levels of meshes added since the last commit, refits
+  // or rebuilds those updated and, when instances were added, removed or
+  // changed or a bottom level changed, the top level (a BVH over the
+  // instances' world boxes), uploads them and makes them what queries see.
+  // On an exception the scene stays as it was: the previous commit answers
+  // queries and the edits stay pending.
   CommitStats commit();
 
   // ---- Queries (of the last commit) ---------------------------------------

@@ -1,7 +1,7 @@
 /* Refit of the 8-wide BVH (src/rtcl/accel/refit.hpp): the tree keeps its
  * shape, the triangle blocks are filled again from new vertices and every
  * node's child boxes are recomputed bottom-up (Bvh8Node, TriangleBlock:
- * shared/layouts.h).
+ * shared/layouts.h), in one launch.
  *
  * Lane vertices: lane_vertices[24 b + 8 k + lane] is the index of corner k
  * (0..2) of the triangle in lane `lane` of triangle block b, or
@@ -9,25 +9,38 @@
  * the triangles' indices when they are new; then each refit reads the
  * corners' indices in block order, not through the triangles.
  *
- * 1. refit_triangle_lanes, one work-item per lane: the lane's corners from
- *    the vertices (consecutive work-items write consecutive floats).
- * 2. Nodes level by level, deepest first (order[] holds the node indices
- *    grouped by wide depth, deepest level first; level_begin[l] ..
- *    level_begin[l + 1] is level l of that order): an inner child's lane
- *    becomes the union of that child's eight lanes, a triangle block's lane
- *    the box of its corners (unused lanes are NaN, which fmin and fmax
- *    ignore); a sphere block's lane stays as built. refit_nodes covers one
- *    level with one work-item per node; refit_levels covers several small
- *    levels in one work-group, a barrier between levels.
+ * refit_bottom_up, one work-item per triangle block, then one per start
+ * node (a node none of whose lanes is a triangle block or an inner node:
+ * only sphere blocks, which keep their build's boxes): a block's
+ * work-item fills its lanes from the vertices, takes the box of their
+ * corners and writes it into its lane of the parent node. Each node counts
+ * the lanes written into it (counters[n], atomically); the work-item whose
+ * write completes the count (arrivals[n]) goes on with that node: it reads
+ * the node's eight lanes, writes the node's share of the SAH cost, writes
+ * the node's box into its own lane of its parent, and so up, until the
+ * root. Every node is thus finished once, after all of its children, by
+ * one work-item, in one launch; the finishing work-item sets the counter
+ * back to 0 for the next refit. up[n] (up_blocks[b]) is the parent's index
+ * times 8 plus the lane (the root's is RTCL_REFIT_ROOT).
+ *
+ * Memory: the lane writes come before a global fence and the counter's
+ * atomic increment; the finishing work-item fences after its increment and
+ * reads the node's lanes through a volatile pointer, so that a device
+ * whose caches are not coherent between compute units reads them from
+ * global memory. This is the classic bottom-up refit of GPU BVH builders;
+ * OpenCL 1.2 promises no order between work-groups, so it relies on the
+ * device's global fences and atomics ordering memory, as a CPU device's
+ * coherent caches do and GPUs' fences do in practice.
  *
  * Boxes are the exact float minima and maxima of the corners (no
- * rounding), so every lane's box contains what lies below it. Each node
- * also writes its share of the tree's SAH cost to cost_parts[node]: the
- * sum over its used lanes of the lane box's area, times node_cost for an
- * inner child, times 1 for a block (refit.cpp sums them). */
+ * rounding), so every lane's box contains what lies below it. cost_parts[n]
+ * is the sum over node n's used lanes of the lane box's area, times
+ * node_cost for an inner child, times 1 for a block (refit.cpp sums
+ * them). */
 #include "shared/layouts.h"
 
 #define RTCL_REFIT_NO_LANE 0xffffffffu
+#define RTCL_REFIT_ROOT 0xffffffffu
 
 kernel void refit_lane_vertices(global const TriangleBlock* blocks, uint lane_count, global const uint* indices,
                                 global uint* lane_vertices) {
@@ -42,100 +55,101 @@ kernel void refit_lane_vertices(global const TriangleBlock* blocks, uint lane_co
   out[2 * RTCL_BLOCK_WIDTH] = t.z;
 }
 
-kernel void refit_triangle_lanes(global TriangleBlock* blocks, uint lane_count, global const uint* lane_vertices,
-                                 global const float* vertices) {
-  const uint i = get_global_id(0);
-  if (i >= lane_count) return;
-  const uint b = i / RTCL_BLOCK_WIDTH, lane = i % RTCL_BLOCK_WIDTH;
-  global const uint* corners = lane_vertices + 3 * RTCL_BLOCK_WIDTH * b + lane;
-  const uint i0 = corners[0], i1 = corners[RTCL_BLOCK_WIDTH], i2 = corners[2 * RTCL_BLOCK_WIDTH];
-  if (i0 == RTCL_REFIT_NO_LANE) return;
-  const float3 a = vload3(i0, vertices), c1 = vload3(i1, vertices), c2 = vload3(i2, vertices);
-  global TriangleBlock* block = blocks + b;
-  block->v[0][0][lane] = a.x;
-  block->v[0][1][lane] = a.y;
-  block->v[0][2][lane] = a.z;
-  block->v[1][0][lane] = c1.x;
-  block->v[1][1][lane] = c1.y;
-  block->v[1][2][lane] = c1.z;
-  block->v[2][0][lane] = c2.x;
-  block->v[2][1][lane] = c2.y;
-  block->v[2][2][lane] = c2.z;
-}
-
-float min8(float8 v) {
-  const float4 m = fmin(v.lo, v.hi);
-  const float2 n = fmin(m.lo, m.hi);
-  return fmin(n.x, n.y);
-}
-
-float max8(float8 v) {
-  const float4 m = fmax(v.lo, v.hi);
-  const float2 n = fmax(m.lo, m.hi);
-  return fmax(n.x, n.y);
-}
-
 float box_area(float3 lo, float3 hi) {
   const float3 e = hi - lo;
   return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
-/* Node n's lanes from their children's lanes and blocks; its cost share. */
-void refit_node(global Bvh8Node* nodes, global const TriangleBlock* blocks, uint n, float node_cost,
-                global float* cost_parts) {
-  global Bvh8Node* node = nodes + n;
+/* Block b's lanes from the vertices; returns their box in *lo, *hi. */
+void fill_block(global TriangleBlock* block, global const uint* corners, global const float* vertices, float3* lo,
+                float3* hi) {
+  float3 l = (float3)(INFINITY), h = (float3)(-INFINITY);
+  for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+    const uint i0 = corners[lane];
+    if (i0 == RTCL_REFIT_NO_LANE) continue;
+    const uint i1 = corners[RTCL_BLOCK_WIDTH + lane], i2 = corners[2 * RTCL_BLOCK_WIDTH + lane];
+    const float3 a = vload3(i0, vertices), b = vload3(i1, vertices), c = vload3(i2, vertices);
+    block->v[0][0][lane] = a.x;
+    block->v[0][1][lane] = a.y;
+    block->v[0][2][lane] = a.z;
+    block->v[1][0][lane] = b.x;
+    block->v[1][1][lane] = b.y;
+    block->v[1][2][lane] = b.z;
+    block->v[2][0][lane] = c.x;
+    block->v[2][1][lane] = c.y;
+    block->v[2][2][lane] = c.z;
+    l = fmin(l, fmin(a, fmin(b, c)));
+    h = fmax(h, fmax(a, fmax(b, c)));
+  }
+  *lo = l;
+  *hi = h;
+}
+
+/* Lane `up % 8` of node `up / 8` set to the box. */
+void write_lane(global Bvh8Node* nodes, uint up, float3 lo, float3 hi) {
+  global Bvh8Node* parent = nodes + up / RTCL_BLOCK_WIDTH;
+  const uint lane = up % RTCL_BLOCK_WIDTH;
+  parent->bounds[0][lane] = lo.x;
+  parent->bounds[1][lane] = lo.y;
+  parent->bounds[2][lane] = lo.z;
+  parent->bounds[3][lane] = hi.x;
+  parent->bounds[4][lane] = hi.y;
+  parent->bounds[5][lane] = hi.z;
+}
+
+/* Node n (every lane written): its cost share into cost_parts[n], its box
+ * into *lo, *hi. */
+void finish_node(global Bvh8Node* nodes, uint n, float node_cost, global float* cost_parts, float3* lo, float3* hi) {
+  volatile global const float* bounds = &nodes[n].bounds[0][0];
+  global const int* child = nodes[n].child;
+  float3 l = (float3)(INFINITY), h = (float3)(-INFINITY);
   float cost = 0.0f;
   for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
-    const int c = node->child[lane];
+    const int c = child[lane];
     if (c == RTCL_CHILD_EMPTY) continue;
-    float3 lo, hi;
-    float weight = 1.0f;
-    if (c >= 0) {
-      global const float* rows = &nodes[c].bounds[0][0];
-      lo = (float3)(min8(vload8(0, rows)), min8(vload8(1, rows)), min8(vload8(2, rows)));
-      hi = (float3)(max8(vload8(3, rows)), max8(vload8(4, rows)), max8(vload8(5, rows)));
-      weight = node_cost;
-    } else if ((~c & 1) == 0) {
-      /* rows 3 k + axis: corner k's coordinate `axis` of the block's lanes */
-      global const float* rows = &blocks[(uint)~c >> 1].v[0][0][0];
-      float8 x0 = vload8(0, rows), y0 = vload8(1, rows), z0 = vload8(2, rows);
-      float8 x1 = vload8(3, rows), y1 = vload8(4, rows), z1 = vload8(5, rows);
-      float8 x2 = vload8(6, rows), y2 = vload8(7, rows), z2 = vload8(8, rows);
-      lo = (float3)(min8(fmin(x0, fmin(x1, x2))), min8(fmin(y0, fmin(y1, y2))), min8(fmin(z0, fmin(z1, z2))));
-      hi = (float3)(max8(fmax(x0, fmax(x1, x2))), max8(fmax(y0, fmax(y1, y2))), max8(fmax(z0, fmax(z1, z2))));
-    } else {
-      lo = (float3)(node->bounds[0][lane], node->bounds[1][lane], node->bounds[2][lane]);
-      hi = (float3)(node->bounds[3][lane], node->bounds[4][lane], node->bounds[5][lane]);
-      cost += box_area(lo, hi);
-      continue;
-    }
-    node->bounds[0][lane] = lo.x;
-    node->bounds[1][lane] = lo.y;
-    node->bounds[2][lane] = lo.z;
-    node->bounds[3][lane] = hi.x;
-    node->bounds[4][lane] = hi.y;
-    node->bounds[5][lane] = hi.z;
-    cost += weight * box_area(lo, hi);
+    const float3 a = (float3)(bounds[lane], bounds[RTCL_BLOCK_WIDTH + lane], bounds[2 * RTCL_BLOCK_WIDTH + lane]);
+    const float3 b = (float3)(bounds[3 * RTCL_BLOCK_WIDTH + lane], bounds[4 * RTCL_BLOCK_WIDTH + lane],
+                              bounds[5 * RTCL_BLOCK_WIDTH + lane]);
+    cost += (c >= 0 ? node_cost : 1.0f) * box_area(a, b);
+    l = fmin(l, a);
+    h = fmax(h, b);
   }
   cost_parts[n] = cost;
+  *lo = l;
+  *hi = h;
 }
 
-/* order[first .. first + count): one level, one node per work-item. */
-kernel void refit_nodes(global Bvh8Node* nodes, global const TriangleBlock* blocks, global const uint* order,
-                        uint first, uint count, float node_cost, global float* cost_parts) {
+kernel void refit_bottom_up(global TriangleBlock* blocks, uint block_count, global const uint* lane_vertices,
+                            global const float* vertices, global Bvh8Node* nodes, global const uint* up_blocks,
+                            global const uint* up, global const uint* arrivals, global uint* counters,
+                            global const uint* start_nodes, uint start_count, float node_cost,
+                            global float* cost_parts) {
   const uint i = get_global_id(0);
-  if (i >= count) return;
-  refit_node(nodes, blocks, order[first + i], node_cost, cost_parts);
-}
-
-/* Levels first_level .. end_level - 1 in turn, by one work-group. */
-kernel void refit_levels(global Bvh8Node* nodes, global const TriangleBlock* blocks, global const uint* order,
-                         global const uint* level_begin, uint first_level, uint end_level, float node_cost,
-                         global float* cost_parts) {
-  for (uint level = first_level; level < end_level; ++level) {
-    const uint end = level_begin[level + 1];
-    for (uint i = level_begin[level] + get_local_id(0); i < end; i += get_local_size(0))
-      refit_node(nodes, blocks, order[i], node_cost, cost_parts);
-    barrier(CLK_GLOBAL_MEM_FENCE);
+  float3 lo, hi;
+  uint n;  /* the node to finish next */
+  if (i < block_count) {
+    fill_block(blocks + i, lane_vertices + 3 * RTCL_BLOCK_WIDTH * i, vertices, &lo, &hi);
+    const uint to = up_blocks[i];
+    write_lane(nodes, to, lo, hi);
+    n = to / RTCL_BLOCK_WIDTH;
+    mem_fence(CLK_GLOBAL_MEM_FENCE);
+    if (atomic_inc(counters + n) + 1 != arrivals[n]) return;
+    counters[n] = 0;
+    mem_fence(CLK_GLOBAL_MEM_FENCE);
+  } else if (i < block_count + start_count) {
+    n = start_nodes[i - block_count];
+  } else {
+    return;
+  }
+  for (;;) {
+    finish_node(nodes, n, node_cost, cost_parts, &lo, &hi);
+    const uint to = up[n];
+    if (to == RTCL_REFIT_ROOT) return;
+    write_lane(nodes, to, lo, hi);
+    n = to / RTCL_BLOCK_WIDTH;
+    mem_fence(CLK_GLOBAL_MEM_FENCE);
+    if (atomic_inc(counters + n) + 1 != arrivals[n]) return;
+    counters[n] = 0;
+    mem_fence(CLK_GLOBAL_MEM_FENCE);
   }
 }

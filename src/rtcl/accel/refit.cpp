@@ -19,13 +19,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Levels with fewer nodes than this are refitted together by one
-// work-group (refit_levels), a barrier between levels, instead of one launch
-// each: the top of a tree has levels of 1, 8, 64 ... nodes, where a
-// launch costs more than the work.
-constexpr std::uint32_t kLevelLaunchMin = 256;
-// That work-group's size (at most the device's).
-constexpr std::size_t kLevelsGroup = 64;
+// refit.cl's RTCL_REFIT_ROOT: the root's entry in up_.
+constexpr std::uint32_t kRefitRoot = 0xffffffffu;
 // Vertices or triangles per host thread in the checks (parallel.hpp).
 constexpr std::size_t kCheckPartMin = 65536;
 
@@ -66,6 +61,102 @@ double bvh8_cost(std::span<const Bvh8Node> nodes) {
   return cost_of(parts, root.area());
 }
 
+// ---- The host refit ----------------------------------------------------------
+
+namespace {
+
+// Triangle blocks and nodes per host thread in refit_bvh8 (parallel.hpp).
+constexpr std::size_t kHostBlocksPerPart = 4096;
+constexpr std::size_t kHostNodesPerPart = 1024;
+
+// Lane `lane` of `node` set to the box.
+void set_lane(Bvh8Node& node, int lane, const glm::vec3& lower, const glm::vec3& upper) {
+  for (int axis = 0; axis < 3; ++axis) {
+    node.bounds[axis][lane] = lower[axis];
+    node.bounds[3 + axis][lane] = upper[axis];
+  }
+}
+
+// Node n's lanes from its children's lanes and blocks, as refit.cl makes
+// them.
+void refit_host_node(std::span<Bvh8Node> nodes, const PrimitiveBlocks& blocks, std::size_t n) {
+  Bvh8Node& node = nodes[n];
+  for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+    const rtcl_i32 c = node.child[lane];
+    if (c == RTCL_CHILD_EMPTY) continue;
+    glm::vec3 lower(INFINITY), upper(-INFINITY);
+    if (c >= 0) {
+      const Bvh8Node& child = nodes[static_cast<std::size_t>(c)];
+      for (int axis = 0; axis < 3; ++axis)
+        for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
+          lower[axis] = std::min(lower[axis], child.bounds[axis][k]);
+          upper[axis] = std::max(upper[axis], child.bounds[3 + axis][k]);
+        }
+    } else if ((~c & 1) == 0) {
+      const TriangleBlock& block = blocks.triangles[static_cast<std::uint32_t>(~c) >> 1];
+      for (int k = 0; k < RTCL_BLOCK_WIDTH; ++k) {
+        if (block.prim[k] < 0) continue;
+        for (int corner = 0; corner < 3; ++corner)
+          for (int axis = 0; axis < 3; ++axis) {
+            lower[axis] = std::min(lower[axis], block.v[corner][axis][k]);
+            upper[axis] = std::max(upper[axis], block.v[corner][axis][k]);
+          }
+      }
+    } else {
+      continue;  // a sphere block: as built
+    }
+    set_lane(node, lane, lower, upper);
+  }
+}
+
+}  // namespace
+
+void refit_bvh8(Bvh8& bvh, const Geometry& geometry, unsigned threads) {
+  // 1. The triangle blocks' used lanes from the vertices.
+  auto& blocks = bvh.blocks.triangles;
+  for_each_part(blocks.size(), part_count(blocks.size(), threads, kHostBlocksPerPart),
+                [&](unsigned, std::size_t begin, std::size_t end) {
+                  for (std::size_t b = begin; b < end; ++b) {
+                    TriangleBlock& block = blocks[b];
+                    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+                      if (block.prim[lane] < 0) continue;
+                      const glm::uvec3 t = geometry.triangles[static_cast<std::size_t>(block.prim[lane])];
+                      const glm::vec3 corners[3] = {geometry.vertices[t.x], geometry.vertices[t.y],
+                                                    geometry.vertices[t.z]};
+                      for (int corner = 0; corner < 3; ++corner)
+                        for (int axis = 0; axis < 3; ++axis) block.v[corner][axis][lane] = corners[corner][axis];
+                    }
+                  }
+                });
+  // 2. The nodes, deepest level first. The flatten numbers a node's
+  // children after it (bvh_flatten.cpp), so one pass in index order gives
+  // every node's depth.
+  const std::size_t count = bvh.nodes.size();
+  std::vector<std::uint32_t> depth(count, 0), at_depth;
+  for (std::size_t n = 0; n < count; ++n) {
+    if (depth[n] >= at_depth.size()) at_depth.resize(depth[n] + 1, 0);
+    ++at_depth[depth[n]];
+    for (const rtcl_i32 c : bvh.nodes[n].child)
+      if (c >= 0) {
+        if (static_cast<std::size_t>(c) <= n || static_cast<std::size_t>(c) >= count)
+          throw Error("internal: refit: node " + std::to_string(n) + " has child " + std::to_string(c) +
+                      " that does not follow it");
+        depth[static_cast<std::size_t>(c)] = depth[n] + 1;
+      }
+  }
+  std::vector<std::uint32_t> begin(at_depth.size() + 1, 0), order(count);
+  for (std::size_t d = 0; d < at_depth.size(); ++d) begin[d + 1] = begin[d] + at_depth[d];
+  std::vector<std::uint32_t> next(begin.begin(), begin.end() - 1);
+  for (std::size_t n = 0; n < count; ++n) order[next[depth[n]]++] = static_cast<std::uint32_t>(n);
+  const std::span<Bvh8Node> nodes(bvh.nodes);
+  for (std::size_t d = at_depth.size(); d-- > 0;) {
+    const std::size_t first = begin[d], level = at_depth[d];
+    for_each_part(level, part_count(level, threads, kHostNodesPerPart), [&](unsigned, std::size_t b, std::size_t e) {
+      for (std::size_t i = first + b; i < first + e; ++i) refit_host_node(nodes, bvh.blocks, order[i]);
+    });
+  }
+}
+
 // ---- The shape ---------------------------------------------------------------
 
 Bvh8Refit::Bvh8Refit(const Bvh8& bvh, const Geometry& geometry)
@@ -75,30 +166,41 @@ Bvh8Refit::Bvh8Refit(const Bvh8& bvh, const Geometry& geometry)
       lane_count_(bvh.blocks.triangles.size() * RTCL_BLOCK_WIDTH),
       spheres_(geometry.spheres),
       zero_area_(bvh.zero_area_triangles) {
-  // Depth of every node, from the root down (a node's children are
-  // reached from it only: the flatten checked the tree).
-  std::vector<std::uint32_t> depth(node_count_, 0);
-  std::vector<std::uint32_t> count_at;  // nodes per depth
-  std::vector<std::uint32_t> todo{0};
-  while (!todo.empty()) {
-    const std::uint32_t n = todo.back();
-    todo.pop_back();
-    if (depth[n] >= count_at.size()) count_at.resize(depth[n] + 1, 0);
-    ++count_at[depth[n]];
-    for (const rtcl_i32 c : bvh.nodes[n].child)
-      if (c >= 0) {
-        depth[static_cast<std::size_t>(c)] = depth[n] + 1;
-        todo.push_back(static_cast<std::uint32_t>(c));
+  // Every node's and triangle block's place in its parent (parent * 8 +
+  // lane), the lanes each node waits for (inner nodes and triangle
+  // blocks), and the nodes that wait for none. Each must be reached once
+  // (the flatten checked the tree; a broken one is an internal error).
+  const std::size_t blocks = bvh.blocks.triangles.size();
+  if (node_count_ >= (std::size_t{1} << 29) || blocks >= (std::size_t{1} << 32))
+    throw Error("refit: the tree has more nodes or blocks than its refit indexes (2^29 nodes)");
+  up_.assign(node_count_, kRefitRoot);
+  up_blocks_.assign(blocks, kRefitRoot);
+  arrivals_.assign(node_count_, 0);
+  std::size_t reached = 1;
+  for (std::size_t n = 0; n < node_count_; ++n)
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+      const rtcl_i32 c = bvh.nodes[n].child[lane];
+      const auto place = static_cast<std::uint32_t>(n * RTCL_BLOCK_WIDTH + static_cast<std::size_t>(lane));
+      std::uint32_t* slot = nullptr;
+      if (c >= 0 && static_cast<std::size_t>(c) < node_count_ && c != 0) {
+        slot = &up_[static_cast<std::size_t>(c)];
+        ++reached;
+      } else if (c < 0 && c != RTCL_CHILD_EMPTY && (~c & 1) == 0 &&
+                 (static_cast<std::uint32_t>(~c) >> 1) < blocks) {
+        slot = &up_blocks_[static_cast<std::uint32_t>(~c) >> 1];
+      } else if (c == RTCL_CHILD_EMPTY || (c < 0 && (~c & 1) == 1)) {
+        continue;  // empty, or a sphere block: as built
       }
-  }
-  // Levels deepest first.
-  const auto levels = static_cast<std::uint32_t>(count_at.size());
-  level_begin_.assign(levels + 1, 0);
-  for (std::uint32_t l = 0; l < levels; ++l) level_begin_[l + 1] = level_begin_[l] + count_at[levels - 1 - l];
-  if (level_begin_[levels] != node_count_) throw Error("internal: refit: the tree does not reach every node");
-  std::vector<std::uint32_t> next(level_begin_.begin(), level_begin_.end() - 1);
-  order_.resize(node_count_);
-  for (std::uint32_t n = 0; n < node_count_; ++n) order_[next[levels - 1 - depth[n]]++] = n;
+      if (!slot || *slot != kRefitRoot)
+        throw Error("internal: refit: node " + std::to_string(n) + " lane " + std::to_string(lane) +
+                    " refers to a child that does not exist or has another parent");
+      *slot = place;
+      ++arrivals_[n];
+    }
+  if (reached != node_count_ || std::find(up_blocks_.begin(), up_blocks_.end(), kRefitRoot) != up_blocks_.end())
+    throw Error("internal: refit: the tree does not reach every node and block");
+  for (std::size_t n = 0; n < node_count_; ++n)
+    if (arrivals_[n] == 0) start_nodes_.push_back(static_cast<std::uint32_t>(n));
   build_cost_ = cost_ = bvh8_cost(bvh.nodes);
 }
 
@@ -108,16 +210,12 @@ Bvh8Refit::~Bvh8Refit() = default;
 // ---- The device side ---------------------------------------------------------
 
 struct Bvh8Refit::DeviceState {
-  // One launch: refit_nodes over one level, or refit_levels over several.
-  struct Run {
-    bool grouped;
-    std::uint32_t first_level, end_level;
-  };
-  cl::Buffer vertices, lane_vertices, order, level_begin, cost_parts;
-  cl::Kernel lane_table, lanes, nodes, levels;
-  std::vector<Run> runs;
-  std::size_t levels_group = kLevelsGroup;
+  cl::Buffer vertices, lane_vertices, up, up_blocks, arrivals, counters, start_nodes, cost_parts;
+  cl::Kernel lane_table, bottom_up;
   std::vector<float> cost_parts_host;
+  // The counters are all 0 (a refit that failed on the device may leave
+  // some counted: the next one clears them first).
+  bool counters_clear = true;
   // The triangles lane_vertices was made from (empty: not made yet).
   std::vector<glm::uvec3> triangles;
 };
@@ -128,29 +226,28 @@ Bvh8Refit::DeviceState& Bvh8Refit::device_state(const Device& device) {
   with_cl_errors([&] {
     cl::Program program = device.program("accel/refit.cl", {});
     st->lane_table = cl::Kernel(program, "refit_lane_vertices");
-    st->lanes = cl::Kernel(program, "refit_triangle_lanes");
-    st->nodes = cl::Kernel(program, "refit_nodes");
-    st->levels = cl::Kernel(program, "refit_levels");
-    st->levels_group = std::min(kLevelsGroup, st->levels.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device.device()));
+    st->bottom_up = cl::Kernel(program, "refit_bottom_up");
   });
   // Buffers of at least one element: OpenCL has no empty buffer.
   const auto bytes = [](std::size_t n, std::size_t each) { return std::max<std::size_t>(n, 1) * each; };
   st->vertices = device.allocate(bytes(vertex_count_, sizeof(glm::vec3)), "refit vertices", CL_MEM_READ_ONLY);
   st->lane_vertices = device.allocate(bytes(lane_count_, 3 * sizeof(std::uint32_t)), "refit lane vertices");
-  st->order = device.upload(order_.data(), order_.size() * sizeof(std::uint32_t), "refit node order");
-  st->level_begin = device.upload(level_begin_.data(), level_begin_.size() * sizeof(std::uint32_t), "refit levels");
+  const auto upload = [&](const std::vector<std::uint32_t>& v, const char* what) {
+    const std::uint32_t none = 0;
+    return v.empty() ? device.upload(&none, sizeof none, what)
+                     : device.upload(v.data(), v.size() * sizeof(std::uint32_t), what);
+  };
+  st->up = upload(up_, "refit parents of nodes");
+  st->up_blocks = upload(up_blocks_, "refit parents of blocks");
+  st->arrivals = upload(arrivals_, "refit lanes per node");
+  st->start_nodes = upload(start_nodes_, "refit start nodes");
+  st->counters = upload(std::vector<std::uint32_t>(node_count_, 0), "refit counters");
   st->cost_parts = device.allocate(node_count_ * sizeof(float), "refit costs");
   st->cost_parts_host.resize(node_count_);
-  const auto levels = static_cast<std::uint32_t>(level_begin_.size() - 1);
-  for (std::uint32_t l = 0; l < levels; ++l) {
-    const bool small = level_begin_[l + 1] - level_begin_[l] < kLevelLaunchMin;
-    if (small && !st->runs.empty() && st->runs.back().grouped)
-      st->runs.back().end_level = l + 1;
-    else
-      st->runs.push_back({small, l, l + 1});
-  }
   device_ = std::move(st);
-  order_ = {};  // on the device now
+  up_ = {};  // on the device now
+  up_blocks_ = {};
+  arrivals_ = {};
   return *device_;
 }
 
@@ -268,44 +365,36 @@ RefitStats Bvh8Refit::run(const Accel& accel, const cl::Buffer& nodes, const cl:
           st.lane_table.setArg(3, st.lane_vertices);
           last.push_back(detail::AccelAccess::launch(accel, st.lane_table, lane_count_, {indices_done}));
         }
-        st.lanes.setArg(0, triangle_blocks);
-        st.lanes.setArg(1, static_cast<cl_uint>(lane_count_));
-        st.lanes.setArg(2, st.lane_vertices);
-        st.lanes.setArg(3, st.vertices);
-        last = {detail::AccelAccess::launch(accel, st.lanes, lane_count_, last)};
       }
-      for (const DeviceState::Run& run : st.runs) {
-        cl::Event done;
-        if (run.grouped) {
-          st.levels.setArg(0, nodes);
-          st.levels.setArg(1, triangle_blocks);
-          st.levels.setArg(2, st.order);
-          st.levels.setArg(3, st.level_begin);
-          st.levels.setArg(4, static_cast<cl_uint>(run.first_level));
-          st.levels.setArg(5, static_cast<cl_uint>(run.end_level));
-          st.levels.setArg(6, kRefitNodeCost);
-          st.levels.setArg(7, st.cost_parts);
-          queue.enqueueNDRangeKernel(st.levels, cl::NullRange, cl::NDRange(st.levels_group),
-                                     cl::NDRange(st.levels_group), &last, &done);
-        } else {
-          const std::uint32_t first = level_begin_[run.first_level];
-          const std::uint32_t count = level_begin_[run.first_level + 1] - first;
-          st.nodes.setArg(0, nodes);
-          st.nodes.setArg(1, triangle_blocks);
-          st.nodes.setArg(2, st.order);
-          st.nodes.setArg(3, static_cast<cl_uint>(first));
-          st.nodes.setArg(4, static_cast<cl_uint>(count));
-          st.nodes.setArg(5, kRefitNodeCost);
-          st.nodes.setArg(6, st.cost_parts);
-          done = detail::AccelAccess::launch(accel, st.nodes, count, last);
-        }
-        last = {done};
+      if (!st.counters_clear) {
+        cl::Event cleared;
+        queue.enqueueFillBuffer(st.counters, cl_uint{0}, 0, node_count_ * sizeof(cl_uint), &last, &cleared);
+        last = {cleared};
       }
+      const auto blocks = static_cast<cl_uint>(lane_count_ / RTCL_BLOCK_WIDTH);
+      const auto starts = static_cast<cl_uint>(start_nodes_.size());
+      cl_uint a = 0;
+      st.bottom_up.setArg(a++, triangle_blocks);
+      st.bottom_up.setArg(a++, blocks);
+      st.bottom_up.setArg(a++, st.lane_vertices);
+      st.bottom_up.setArg(a++, st.vertices);
+      st.bottom_up.setArg(a++, nodes);
+      st.bottom_up.setArg(a++, st.up_blocks);
+      st.bottom_up.setArg(a++, st.up);
+      st.bottom_up.setArg(a++, st.arrivals);
+      st.bottom_up.setArg(a++, st.counters);
+      st.bottom_up.setArg(a++, st.start_nodes);
+      st.bottom_up.setArg(a++, starts);
+      st.bottom_up.setArg(a++, kRefitNodeCost);
+      st.bottom_up.setArg(a++, st.cost_parts);
+      st.counters_clear = false;  // until the launch is known to have finished
+      last = {detail::AccelAccess::launch(accel, st.bottom_up, std::size_t{blocks} + starts, last)};
       cl::Event costs_read, root_read;
       queue.enqueueReadBuffer(st.cost_parts, CL_FALSE, 0, node_count_ * sizeof(float), st.cost_parts_host.data(),
                               &last, &costs_read);
       queue.enqueueReadBuffer(nodes, CL_FALSE, 0, sizeof(Bvh8Node), &root, &last, &root_read);
       cl::Event::waitForEvents({costs_read, root_read});
+      st.counters_clear = true;
     });
   } catch (...) {
     device.queue().finish();  // no command may still read the caller's arrays

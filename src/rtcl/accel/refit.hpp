@@ -10,10 +10,12 @@
 // shared by about six triangles, 36 for a soup) and gathers them through a
 // table of each block lane's corner indices that it makes from the
 // triangles once (kept while the triangles stay the same: the host keeps a
-// copy to compare). On a GPU the gather runs at the device's memory
-// bandwidth, one lane per work-item with coalesced writes; on a CPU device
-// it runs on the same cores a host pool would, with every lane's loads
-// independent of the others'.
+// copy to compare). One launch does the rest (refit.cl, refit_bottom_up):
+// one work-item per triangle block fills its lanes and carries the block's
+// box up the tree, the last child to arrive at a node finishing it, so
+// that a small mesh pays one launch, not one per level of the tree; on a
+// CPU device it runs on the same cores a host pool would, with every
+// block's loads independent of the others'.
 #pragma once
 
 #include <cstddef>
@@ -35,6 +37,18 @@ double bvh8_cost(std::span<const Bvh8Node> nodes);
 
 // A wide node's weight in that cost, against one block test.
 inline constexpr float kRefitNodeCost = 0.5f;
+
+// The refit of a host image (the scene's bottom levels, src/rtcl/scene/
+// mesh_refit.hpp, which keep their images and upload them): the same
+// update as the device's, on up to `threads` host threads (0 = all; the
+// result does not depend on them). Every used lane of a triangle block is
+// filled again from geometry's vertices through its primitive id, and
+// every node's child boxes are recomputed bottom-up as the exact float
+// minima and maxima of what lies below (sphere lanes stay as built).
+// `geometry` must be the one the image was built over with new vertices
+// (the caller checks counts and values); nothing checks zero-area
+// triangles or the cost (bvh8_cost does).
+void refit_bvh8(Bvh8& bvh, const Geometry& geometry, unsigned threads = 0);
 
 // What a refit needs of one built BVH: its shape (taken from the host image
 // at the build), the build's counts, spheres and zero-area triangles, and,
@@ -68,10 +82,11 @@ class Bvh8Refit {
   std::size_t lane_count_ = 0;                  // triangle blocks * 8
   std::vector<Sphere> spheres_;                 // as built: a refit moves triangles only
   std::vector<std::uint32_t> zero_area_;        // triangles skipped at the build
-  // Node indices by wide depth, deepest level first; level l is
-  // order_[level_begin_[l] .. level_begin_[l + 1]) (order_ moves to the
-  // device at the first refit).
-  std::vector<std::uint32_t> order_, level_begin_;
+  // The tree's shape for refit.cl's refit_bottom_up (moved to the device
+  // at the first refit): each node's and triangle block's parent * 8 +
+  // lane (the root's 0xffffffff), the lanes each node waits for, and the
+  // nodes that wait for none.
+  std::vector<std::uint32_t> up_, up_blocks_, arrivals_, start_nodes_;
   double build_cost_ = 0.0, cost_ = 0.0;        // cost_: the tree's now
   std::unique_ptr<DeviceState> device_;
 };

@@ -12,9 +12,11 @@
 #include <mutex>
 
 #include "rtcl/accel/accel_state.hpp"
+#include "rtcl/accel/refit.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/query/host_batches.hpp"
 #include "rtcl/scene.hpp"
+#include "rtcl/scene/mesh_refit.hpp"
 #include "rtcl/scene/two_level.hpp"
 
 namespace rtcl {
@@ -26,6 +28,7 @@ struct MeshEntry {
   std::string structure;  // the structure's name ("bvh", "bvh-ploc", "bvh-packet")
   AccelOptions options;   // resolved (every declared option)
   BvhConfig config;
+  std::optional<RefitPolicy> refit;           // MeshOptions::refit
   std::shared_ptr<const MeshBuild> built;     // null: to build at the next commit
   std::shared_ptr<const MeshBuild> previous;  // the build that update_vertices replaced (same triangles)
   std::size_t instances = 0;                  // pending instances that use it
@@ -57,6 +60,7 @@ std::shared_ptr<const MeshBuild> build_mesh(const MeshEntry& entry) {
   build->structure = entry.structure;
   build->config = entry.config;
   build->built = build_bvh(*entry.geometry, entry.config);
+  build->build_cost = bvh8_cost(build->built.bvh.nodes);
   const Bvh8Node& root = build->built.bvh.nodes.at(0);
   for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane)
     if (root.child[lane] != RTCL_CHILD_EMPTY) build->root_boxes.push_back(bvh8_lane_box(root, lane));
@@ -85,7 +89,7 @@ struct Scene::State {
   std::vector<std::optional<Instance>> instances;  // by InstanceId; removed: empty
   std::size_t live_instances = 0;
   bool instances_changed = false;
-  std::size_t bottom_levels_built = 0, top_levels_built = 0;
+  std::size_t bottom_levels_built = 0, bottom_levels_refitted = 0, top_levels_built = 0;
 
   // The published commit (the pointer alone is guarded).
   mutable std::mutex committed_mutex;
@@ -160,6 +164,10 @@ MeshId Scene::add_mesh(const Geometry& geometry, const MeshOptions& options) {
   entry.options = resolve_options(structure_spec(spec.name), given, call);
   entry.structure = spec.name;
   entry.config = bvh_config_from(entry.options);
+  if (options.refit && !(options.refit->max_cost_ratio >= 1.0))
+    throw Error("Scene::add_mesh refit.max_cost_ratio: " + std::to_string(options.refit->max_cost_ratio) +
+                " must be >= 1 (+inf: never rebuild on cost)");
+  entry.refit = options.refit;
   if (spec.name == "bvh-packet") entry.config.traversal = BvhTraversal::packet;
   try {
     validate(geometry);
@@ -276,19 +284,27 @@ CommitStats Scene::commit() {
   CommitStats stats;
 
   // Bottom levels of new and updated meshes, kept aside until the commit
-  // succeeds.
+  // succeeds. A mesh whose vertices moved over the same triangles
+  // (update_vertices; entry.previous is its last build) is refitted from
+  // that build (src/rtcl/scene/mesh_refit.hpp) unless its policy asks for a
+  // rebuild; refit_source holds the build each refit started from.
   std::map<std::uint32_t, std::shared_ptr<const MeshBuild>> builds;
+  std::map<std::uint32_t, const MeshBuild*> refit_source;
   for (const auto& [id, entry] : st.meshes) {
     if (entry.built) {
       builds.emplace(id, entry.built);
       continue;
     }
-    // Refit point: a mesh whose vertices moved over the same triangles
-    // (update_vertices; entry.previous is its last build) is rebuilt here.
-    // Where its structure supports a refit (the BVH family's
-    // Accel::refit, src/rtcl/accel/refit.*), this call becomes that refit
-    // of entry.previous's tree, and a rebuild where the refit declines.
     try {
+      if (entry.previous && entry.refit) {
+        MeshRefit refit = refit_mesh(*entry.previous, entry.geometry, *entry.refit);
+        if (refit.build) {
+          builds.emplace(id, std::move(refit.build));
+          refit_source.emplace(id, entry.previous.get());
+          ++stats.bottom_levels_refitted;
+          continue;
+        }
+      }
       builds.emplace(id, build_mesh(entry));
     } catch (const Error& e) {
       throw Error("Scene::commit " + mesh_name(id, *entry.geometry) + ": " + e.what());
@@ -322,17 +338,30 @@ CommitStats Scene::commit() {
       next->stats.single_level = true;
     } else {
       std::map<std::uint32_t, std::uint32_t> bottom_of;
+      const bool had_two_levels = previous && previous->two_level;
+      std::vector<bool> refitted;  // bottom k is a refit of the previous commit's bottom k
       for (const auto& [id, build] : builds) {
-        bottom_of[id] = static_cast<std::uint32_t>(next->bottom_meshes.size());
+        const std::size_t k = next->bottom_meshes.size();
+        bottom_of[id] = static_cast<std::uint32_t>(k);
         next->bottom_meshes.push_back(build);
+        const auto source = refit_source.find(id);
+        refitted.push_back(had_two_levels && source != refit_source.end() && k < previous->bottom_meshes.size() &&
+                           previous->bottom_meshes[k].get() == source->second);
       }
-      const bool same_bottoms = previous && previous->two_level && previous->bottom_meshes == next->bottom_meshes;
+      const bool same_bottoms = had_two_levels && previous->bottom_meshes == next->bottom_meshes;
       if (same_bottoms && !st.instances_changed) {
         next->two_level = previous->two_level;
       } else {
-        std::shared_ptr<const DeviceBottoms> bottoms =
-            same_bottoms ? previous->two_level->bottoms()
-                         : std::make_shared<const DeviceBottoms>(upload_bottoms(st.device, next->bottom_meshes));
+        // The previous commit's bottom levels; else, where only refits
+        // changed them, a device copy with the refitted meshes' ranges
+        // written anew; else every mesh uploaded.
+        std::shared_ptr<const DeviceBottoms> bottoms;
+        if (same_bottoms)
+          bottoms = previous->two_level->bottoms();
+        else if (had_two_levels && !refit_source.empty())
+          bottoms = refit_bottoms(st.device, *previous->two_level->bottoms(), previous->bottom_meshes,
+                                  next->bottom_meshes, refitted);
+        if (!bottoms) bottoms = std::make_shared<const DeviceBottoms>(upload_bottoms(st.device, next->bottom_meshes));
         std::vector<PlacedInstance> placed;
         placed.reserve(live.size());
         for (std::uint32_t i : live) {
@@ -357,10 +386,12 @@ CommitStats Scene::commit() {
   }
   st.instances_changed = false;
   st.bottom_levels_built += stats.bottom_levels_built;
+  st.bottom_levels_refitted += stats.bottom_levels_refitted;
   if (stats.top_level_built) ++st.top_levels_built;
   next->stats.meshes = st.meshes.size();
   next->stats.instances = live.size();
   next->stats.bottom_levels_built = st.bottom_levels_built;
+  next->stats.bottom_levels_refitted = st.bottom_levels_refitted;
   next->stats.top_levels_built = st.top_levels_built;
   stats.build_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   {

@@ -34,6 +34,8 @@ struct MeshBuild {
   // The boxes of the root node's children (object space): an instance's
   // world box is the box of their transformed corners.
   std::vector<Aabb> root_boxes;
+  // The tree's SAH cost (bvh8_cost) at its build; a refit keeps it.
+  double build_cost = 0.0;
 };
 
 // The bottom levels of a commit on the device, in the order given.
