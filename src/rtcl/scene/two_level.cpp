@@ -369,7 +369,10 @@ TwoLevel::TwoLevel(const Device& device, Precision precision, std::shared_ptr<co
            motions.size() * sizeof(InstanceMotion);
   top_ = device.upload(top.nodes.data(), top.nodes.size() * sizeof(Bvh8Node), "scene top-level nodes");
   instances_ = device.upload(records.data(), records.size() * sizeof(InstanceRecord), "scene instances");
-  motions_ = device.upload(motions.data(), motions.size() * sizeof(InstanceMotion), "scene instance motions");
+  if (!moving_ && previous && !previous->moving_)  // both the one-record placeholder, never written
+    motions_ = previous->motions_;
+  else
+    motions_ = device.upload(motions.data(), motions.size() * sizeof(InstanceMotion), "scene instance motions");
   if (previous) {  // read only (times) and never written (ids): shared
     no_times_ = previous->no_times_;
     no_ids_ = previous->no_ids_;
