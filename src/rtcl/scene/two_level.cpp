@@ -188,8 +188,13 @@ struct TopCollapse {
 };
 
 
-// Instances per host thread in the pass over them (parallel.hpp).
-constexpr std::size_t kInstancesPerPart = 4096;
+// Instances per host thread in the pass over them and in the top level's
+// build (parallel.hpp): below some 30k instances the whole top level takes
+// a few milliseconds on one thread, and a hand-off to a pooled thread that
+// is asleep (after set_transform calls, a commit's threads have slept) or
+// not running (a busy host) can cost as much as the work; larger scenes
+// gain from the threads.
+constexpr std::size_t kInstancesPerPart = 32768;
 
 // The top level's RTCL_TOP_STACK_SIZE: a power of two, at least 64, so
 // that commits of a changing top level reuse one compiled program.
@@ -277,7 +282,9 @@ void build_top_level(std::span<const Aabb> world_boxes, TopLevel& top) {
   for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::uint32_t>(i);
   // Leaves of up to eight instances, each opened into the lanes of one
   // wide node (TopCollapse).
-  BuildTree tree = build_sah(world_boxes, ids, SahConfig{});
+  SahConfig sah;
+  sah.thread_count = part_count(world_boxes.size(), 0, kInstancesPerPart);
+  BuildTree tree = build_sah(world_boxes, ids, sah);
   top.stack_size = 0;
   TopCollapse{tree, world_boxes, top}.form(0, 0, 0);
   if (top.stack_size > kBvhMaxStackSize)
