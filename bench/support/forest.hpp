@@ -23,9 +23,6 @@ std::vector<Transform> forest_placements(std::size_t count, const Aabb& bounds, 
 // of view of 50 degrees).
 Camera forest_camera(std::size_t count, const Aabb& bounds);
 
-}  // namespace rtcl::bench
-
-namespace rtcl::bench {
 
 // The ms (CommitStats::build_ms) of `repeat` commits of `scene`, each after
 // every instance ids[k] was set to placements[k] again (set_transform): a
