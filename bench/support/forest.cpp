@@ -37,7 +37,6 @@ Camera forest_camera(std::size_t count, const Aabb& bounds) {
   return {{-0.1f * width, 0.3f * width, -0.1f * width}, {0.5f * width, 0.0f, 0.5f * width}, {0, 1, 0}, 50.0f};
 }
 
-
 std::vector<double> top_level_commit_ms(Scene& scene, const std::vector<InstanceId>& ids,
                                         const std::vector<Transform>& placements, int repeat) {
   std::vector<double> ms;

@@ -23,7 +23,6 @@ std::vector<Transform> forest_placements(std::size_t count, const Aabb& bounds, 
 // of view of 50 degrees).
 Camera forest_camera(std::size_t count, const Aabb& bounds);
 
-
 // The ms (CommitStats::build_ms) of `repeat` commits of `scene`, each after
 // every instance ids[k] was set to placements[k] again (set_transform): a
 // pure instance edit, so each commit builds the top level alone.
