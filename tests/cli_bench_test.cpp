@@ -194,6 +194,35 @@ TEST(CliBench, PrecisionAndEmbreeFlagsAreRecorded) {
   EXPECT_NE(read_text(dir.file("out/bench.md")).find("precision fast"), std::string::npos);
 }
 
+// --instances adds the instanced-scene section: rtcl's top-level commits and
+// traces, and Embree's, with the same instance and triangle on (nearly)
+// every ray.
+TEST(CliBench, InstancesSectionComparesTheScenes) {
+  TempDir dir;
+  CliRun run = run_cli(dir,
+                       {"bench", "--size", "16", "--scene", "tetra:levels=1", "--accel", "bvh", "--rays", "primary",
+                        "--repeat", "2", "--check-rays", "8", "--device", "0", "--instances", "50", "-o",
+                        dir.file("out")},
+                       scenes_env());
+  ASSERT_EQ(run.status, 0) << run.err;
+  nlohmann::json json = nlohmann::json::parse(read_text(dir.file("out/bench.json")));
+  ASSERT_EQ(json["instances"].size(), 1u) << json.dump();
+  const nlohmann::json& section = json["instances"][0];
+  EXPECT_EQ(section["mesh"], "bunny");
+  EXPECT_EQ(section["instances"], 50);
+  EXPECT_EQ(section["rays"], 256);
+  EXPECT_EQ(section["commit_ms_runs"].size(), 2u);
+  EXPECT_EQ(section["trace_ms_runs"].size(), 2u);
+  EXPECT_GT(section["device_bytes"].get<double>(), 0.0);
+#ifdef RTCL_TESTS_EXPECT_EMBREE
+  ASSERT_TRUE(section["embree"].is_object()) << section.dump();
+  EXPECT_EQ(section["embree"]["commit_ms_runs"].size(), 2u);
+  EXPECT_EQ(section["embree"]["trace_ms_runs"].size(), 2u);
+  EXPECT_GE(section["embree"]["agreeing"].get<double>(), 0.95 * 256) << section.dump();
+#endif
+  EXPECT_NE(read_text(dir.file("out/bench.md")).find("### 50 instances of bunny"), std::string::npos);
+}
+
 // Each bad input: a non-zero exit and one "rtcl: error:" line naming it,
 // nothing written.
 TEST(CliBench, BadInputIsOneMessageBeforeDeviceWork) {
@@ -211,6 +240,7 @@ TEST(CliBench, BadInputIsOneMessageBeforeDeviceWork) {
       {{"--rays", "primary,caustic"}, "unknown ray set 'caustic'"},
       {{"--repeat", "0"}, "--repeat"},
       {{"--precision", "medium"}, "--precision medium: unknown precision level"},
+      {{"--instances", "-3"}, "--instances"},
       {{"-o", dir.file("blocker") + "/out"}, "cannot create the directory"},
   };
   for (const Case& c : cases) {

@@ -348,6 +348,42 @@ TEST(TwoLevel, SpheresThroughSimilarityTransforms) {
   EXPECT_GT(hit_count, rays.size() / 10);
 }
 
+// A scene of one transformed instance (its rays go to the bottom level
+// without the top level's box test): closest and any hit judged against the
+// double-precision reference on its pre-transformed copy, at every level.
+TEST(TwoLevel, OneTransformedInstanceAnswersAsItsCopy) {
+  const Geometry mesh = soup_mesh();
+  for (const Transform& t : {varied_transforms()[3], varied_transforms()[5]}) {
+    const FlatInstances flat = flatten_instances(mesh, {t});
+    const std::vector<Ray> rays = random_rays(flat.geometry, 2000, 7);
+    const std::vector<Hit> references = reference_closest_all(flat.geometry, rays);
+    for (Precision level : test_precisions()) {
+      Scene scene(test_device(), {level});
+      scene.add_instance(scene.add_mesh(mesh), t);
+      scene.commit();
+      ASSERT_FALSE(scene.stats().single_level);
+      std::vector<std::uint32_t> ids(rays.size());
+      const std::vector<Hit> hits = scene.intersect(rays, ids);
+      std::vector<Hit> any(rays.size());
+      scene.trace(Query::any, rays, any);
+      std::size_t hit_count = 0;
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        EXPECT_EQ(ids[i], hits[i].prim >= 0 ? 0u : kNoInstance);
+        hit_count += hits[i].prim >= 0;
+      }
+      expect_at_level(level, false, "one instance at " + std::string(precision_name(level)), [&] {
+        std::size_t closest_failures = 0, any_failures = 0;
+        std::vector<std::string> closest =
+            judge_all(flat.geometry, rays, hits, Query::closest, references, &closest_failures, 3);
+        std::vector<std::string> blocked = judge_all(flat.geometry, rays, any, Query::any, &any_failures, 3);
+        EXPECT_EQ(closest_failures, 0u) << (closest.empty() ? "" : closest.front());
+        EXPECT_EQ(any_failures, 0u) << (blocked.empty() ? "" : blocked.front());
+      });
+      EXPECT_GT(hit_count, rays.size() / 5);
+    }
+  }
+}
+
 // The top level over instance boxes: every instance in exactly one leaf
 // slot, every slot's box containing the boxes below it.
 TEST(TwoLevel, TopLevelHoldsEveryInstanceOnce) {

@@ -19,24 +19,22 @@
 //   rtcl_instances_bench [--scenes-dir DIR] [--size 1024] [--repeat 5] [--counts 1000,10000,100000]
 //                        [--forest 10000]
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <functional>
-#include <random>
 #include <sstream>
 #include <string>
-#include <thread>
 #include <vector>
 
+#include "bench/support/forest.hpp"
 #include "bench/support/ray_sets.hpp"
 #include "bench/support/scenes_dir.hpp"
 #include "bench/support/timing.hpp"
 #include "rtcl/rtcl.hpp"
 #include "rtcl/scene/mesh_io.hpp"
 #ifdef RTCL_HAVE_EMBREE
-#include <embree3/rtcore.h>
+#include "bench/support/embree_instances.hpp"
 #endif
 
 namespace {
@@ -70,111 +68,6 @@ std::vector<std::size_t> split_counts(const std::string& text) {
   return out;
 }
 
-// `count` placements of a mesh with box `bounds` on a square grid in the
-// xz plane: each centred, turned about y and scaled by 0.8 .. 1.2.
-std::vector<rtcl::Transform> forest(std::size_t count, const rtcl::Aabb& bounds, std::uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> turn(0.0f, 360.0f), size(0.8f, 1.2f);
-  const glm::vec3 c = bounds.center(), e = bounds.extent();
-  const float spacing = 1.3f * std::max(e.x, e.z);
-  const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(count))));
-  std::vector<rtcl::Transform> out;
-  for (std::size_t k = 0; k < count; ++k) {
-    const float x = spacing * static_cast<float>(k % side), z = spacing * static_cast<float>(k / side);
-    out.push_back(rtcl::Transform::translate(x, 0, z) * rtcl::Transform::rotate(turn(rng), 0, 1, 0) *
-                  rtcl::Transform::scale(size(rng)) * rtcl::Transform::translate(-c.x, -c.y, -c.z));
-  }
-  return out;
-}
-
-#ifdef RTCL_HAVE_EMBREE
-// One child scene of the mesh and a top scene of its instances.
-class EmbreeInstances {
- public:
-  EmbreeInstances(RTCDevice device, const rtcl::Geometry& mesh) : device_(device) {
-    child_ = rtcNewScene(device);
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.vertices.data(), 0,
-                               sizeof(glm::vec3), mesh.vertices.size());
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.triangles.data(), 0,
-                               sizeof(glm::uvec3), mesh.triangles.size());
-    rtcCommitGeometry(g);
-    rtcAttachGeometry(child_, g);
-    rtcReleaseGeometry(g);
-    auto start = Clock::now();
-    rtcCommitScene(child_);
-    child_ms_ = ms_since(start);
-  }
-  ~EmbreeInstances() {
-    if (top_) rtcReleaseScene(top_);
-    rtcReleaseScene(child_);
-  }
-
-  // A new top scene of the placements: returns the ms of its geometry
-  // setup and of rtcCommitScene.
-  std::pair<double, double> place(const std::vector<rtcl::Transform>& transforms) {
-    if (top_) rtcReleaseScene(top_);
-    auto start = Clock::now();
-    top_ = rtcNewScene(device_);
-    for (std::size_t k = 0; k < transforms.size(); ++k) {
-      RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
-      rtcSetGeometryInstancedScene(g, child_);
-      rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &transforms[k].m[0][0]);
-      rtcCommitGeometry(g);
-      rtcAttachGeometryByID(top_, g, static_cast<unsigned>(k));
-      rtcReleaseGeometry(g);
-    }
-    const double setup = ms_since(start);
-    start = Clock::now();
-    rtcCommitScene(top_);
-    return {setup, ms_since(start)};
-  }
-
-  // rtcIntersect1 over `records` in place on `threads` threads.
-  void trace(std::vector<RTCRayHit>& records, unsigned threads) const {
-    std::atomic<std::size_t> next{0};
-    constexpr std::size_t kBlock = 4096;
-    auto work = [&] {
-      RTCIntersectContext context;
-      rtcInitIntersectContext(&context);
-      for (std::size_t begin; (begin = next.fetch_add(kBlock)) < records.size();)
-        for (std::size_t i = begin; i < std::min(begin + kBlock, records.size()); ++i)
-          rtcIntersect1(top_, &context, &records[i]);
-    };
-    std::vector<std::thread> pool;
-    for (unsigned t = 1; t < threads; ++t) pool.emplace_back(work);
-    work();
-    for (std::thread& t : pool) t.join();
-  }
-
-  double child_ms() const { return child_ms_; }
-
- private:
-  RTCDevice device_;
-  RTCScene child_ = nullptr, top_ = nullptr;
-  double child_ms_ = 0.0;
-};
-
-std::vector<RTCRayHit> embree_records(const std::vector<rtcl::Ray>& rays) {
-  std::vector<RTCRayHit> out(rays.size());
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    const rtcl::Ray& r = rays[i];
-    RTCRayHit& h = out[i];
-    h.ray.org_x = r.ox, h.ray.org_y = r.oy, h.ray.org_z = r.oz;
-    h.ray.dir_x = r.dx, h.ray.dir_y = r.dy, h.ray.dir_z = r.dz;
-    h.ray.tnear = r.tmin;
-    h.ray.tfar = r.tmax;
-    h.ray.time = 0.0f;
-    h.ray.mask = ~0u;
-    h.ray.id = 0;
-    h.ray.flags = 0;
-    h.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    h.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  }
-  return out;
-}
-#endif
-
 }  // namespace
 
 int main(int argc, char** argv) try {
@@ -200,27 +93,21 @@ int main(int argc, char** argv) try {
   std::printf("device: %s; bunny (%zu triangles); medians of %d calls\n\n", device.info().name.c_str(),
               bunny.triangles.size(), repeat);
 #ifdef RTCL_HAVE_EMBREE
-  RTCDevice embree = rtcNewDevice("threads=2");
-  if (!embree) throw rtcl::Error("Embree: rtcNewDevice failed");
-  EmbreeInstances embree_scene(embree, bunny);
+  rtcl::bench::EmbreeInstances embree_scene(bunny, 2);
   std::printf("Embree child scene commit (bunny): %.1f ms\n\n", embree_scene.child_ms());
 #endif
 
   // ---- Top-level build -------------------------------------------------------
   std::printf("| instances | rtcl commit ms | Embree setup ms | Embree commit ms | rtcl/Embree commit |\n|---|---|---|---|---|\n");
   for (std::size_t count : split_counts(counts_text)) {
-    const std::vector<rtcl::Transform> placed = forest(count, bunny.bounds(), 1);
+    const std::vector<rtcl::Transform> placed = rtcl::bench::forest_placements(count, bunny.bounds(), 1);
     rtcl::Scene scene(device);
     rtcl::MeshId mesh = scene.add_mesh(bunny);
     std::vector<rtcl::InstanceId> ids;
     for (const rtcl::Transform& t : placed) ids.push_back(scene.add_instance(mesh, t));
     scene.commit();  // the bottom level, and a first top level
-    std::vector<double> ms;
-    for (int r = 0; r <= repeat; ++r) {
-      for (std::size_t k = 0; k < ids.size(); ++k) scene.set_transform(ids[k], placed[k]);  // the top level is due
-      rtcl::CommitStats stats = scene.commit();
-      if (r > 0) ms.push_back(stats.build_ms);
-    }
+    std::vector<double> ms = rtcl::bench::top_level_commit_ms(scene, ids, placed, repeat + 1);
+    ms.erase(ms.begin());  // the warm-up
     const double rtcl_ms = median(ms);
     std::string embree_setup = "-", embree_commit = "-", ratio = "-";
 #ifdef RTCL_HAVE_EMBREE
@@ -278,15 +165,12 @@ int main(int argc, char** argv) try {
 
   // ---- The forest --------------------------------------------------------------
   {
-    const std::vector<rtcl::Transform> placed = forest(forest_count, bunny.bounds(), 2);
+    const std::vector<rtcl::Transform> placed = rtcl::bench::forest_placements(forest_count, bunny.bounds(), 2);
     rtcl::Scene scene(device);
     rtcl::MeshId mesh = scene.add_mesh(bunny);
     for (const rtcl::Transform& t : placed) scene.add_instance(mesh, t);
     rtcl::CommitStats built = scene.commit();
-    const rtcl::Aabb b = bunny.bounds();
-    const float width = 1.3f * std::max(b.extent().x, b.extent().z) * std::ceil(std::sqrt(float(forest_count)));
-    rtcl::bench::Camera camera{{-0.1f * width, 0.3f * width, -0.1f * width}, {0.5f * width, 0.0f, 0.5f * width},
-                               {0, 1, 0}, 50.0f};
+    const rtcl::bench::Camera camera = rtcl::bench::forest_camera(forest_count, bunny.bounds());
     const std::vector<rtcl::Ray> rays = rtcl::bench::primary_rays(camera, size, size);
     const std::size_t n = rays.size();
     cl::Buffer ray_buffer = device.upload(rays.data(), n * sizeof(rtcl::Ray), "bench rays");
@@ -304,19 +188,17 @@ int main(int argc, char** argv) try {
 #ifdef RTCL_HAVE_EMBREE
     embree_scene.place(placed);
     std::vector<double> ms;
-    std::vector<RTCRayHit> records;
+    std::vector<rtcl::bench::InstanceHit> answers;
     for (int r = 0; r <= repeat; ++r) {
-      records = embree_records(rays);
-      auto start = Clock::now();
-      embree_scene.trace(records, 2);
-      if (r > 0) ms.push_back(ms_since(start));
+      const double traced = embree_scene.trace(rays, &answers);
+      if (r > 0) ms.push_back(traced);
     }
     const double embree_ms = median(ms);
     std::size_t same = 0;
     for (std::size_t i = 0; i < n; ++i) {
-      const bool embree_hit = records[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      const bool embree_hit = answers[i].prim >= 0;
       same += embree_hit == (hits[i].prim >= 0) &&
-              (!embree_hit || (records[i].hit.instID[0] == ids[i] && static_cast<int>(records[i].hit.primID) == hits[i].prim));
+              (!embree_hit || (answers[i].instance == ids[i] && answers[i].prim == hits[i].prim));
     }
     embree_rate = fixed(mrays / embree_ms, 1);
     ratio = fixed(embree_ms / rtcl_ms, 2);
@@ -325,9 +207,6 @@ int main(int argc, char** argv) try {
     std::printf("| rtcl Mrays/s | Embree rtcIntersect1 Mrays/s | rtcl/Embree | same instance and triangle %% |\n|---|---|---|---|\n");
     std::printf("| %.1f | %s | %s | %s |\n", mrays / rtcl_ms, embree_rate.c_str(), ratio.c_str(), agree.c_str());
   }
-#ifdef RTCL_HAVE_EMBREE
-  rtcReleaseDevice(embree);
-#endif
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "rtcl_instances_bench: error: %s\n", e.what());

@@ -21,6 +21,10 @@
  * A^-1 its inverse computed here (cofactors over the determinant, float).
  * Their top-level boxes hold the mesh over the whole of [0, 1].
  *
+ * RTCL_TOP_ONE_INSTANCE (a scene of one instance): the ray goes to
+ * instance 0 without the top level's box test, which only culls what the
+ * bottom level's root culls too.
+ *
  * Stacks: the top level's traversal keeps its own (RTCL_TOP_STACK_SIZE,
  * the top tree's bound as the host computes it for the BVH) and calls
  * bvh_traverse for a bottom level, which keeps its own (RTCL_STACK_SIZE,
@@ -191,7 +195,12 @@ kernel void RTCL_TRACE_KERNEL_NAME(instances)(global const Ray* rays, global Hit
   TraceRay s;
   HitState h;
   uint hit_instance = 0;
+#ifdef RTCL_TOP_ONE_INSTANCE
+  /* a top level of one instance: its bottom level's root decides alone */
+  if (begin_trace(rays, i, &s, &h)) instance_visit(0, &s, &h, tau, &hit_instance, INSTANCES_ARGS);
+#else
   if (begin_trace(rays, i, &s, &h)) instances_traverse(&s, &h, tau, &hit_instance, INSTANCES_ARGS);
+#endif
   end_trace(hits, i, &h);
   if (write_ids) instance_ids[i] = h.prim >= 0 ? instances[hit_instance].user_id : 0xffffffffu;
 }

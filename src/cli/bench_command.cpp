@@ -20,6 +20,7 @@
 
 #include "bench_matrix.hpp"
 #include "bench_embree.hpp"
+#include "bench_instances.hpp"
 #include "bench_report.hpp"
 #include "bench_scenes.hpp"
 #include "cli_errors.hpp"
@@ -219,6 +220,14 @@ BenchMatrix check_bench_inputs(const BenchOptions& options, bool create_output) 
   }
   std::string scenes_dir = options.scenes_dir.empty() ? bench::scenes_dir_from_env() : options.scenes_dir;
   for (const std::string& s : split_spec_list(options.scene)) m.scenes.push_back(parse_bench_scene(s, scenes_dir));
+  m.scenes_dir = scenes_dir;
+  if (options.instances > 0) {
+    try {
+      parse_bench_scene("bunny", scenes_dir);
+    } catch (const std::exception& e) {
+      throw UsageError("--instances " + std::to_string(options.instances) + ": the instanced mesh: " + e.what());
+    }
+  }
   for (const std::string& r : split_spec_list(options.rays)) {
     auto k = std::find(std::begin(kind_names), std::end(kind_names), r);
     if (k == std::end(kind_names))
@@ -421,6 +430,11 @@ void run_bench(const BenchOptions& options) {
         ++done;
       }
   }
+  if (options.instances > 0) {
+    step(done, total, std::to_string(options.instances) + " instances of bunny / " + run.devices.front().name);
+    run.instances.push_back(bench_instances(devices.front(), options, matrix.scenes_dir,
+                                            run.embree_version.empty() ? 0u : options.embree_threads));
+  }
   progress.clear();
   write_bench_results(run, matrix);
 }
@@ -470,6 +484,11 @@ void add_bench_command(CLI::App& app) {
       ->check(one_of({"measured", "always", "never"}, "sort policy"));
   cmd->add_option("--embree-threads", options->embree_threads, "host threads Embree traces and builds on")
       ->check(integer_in(1, 1024))
+      ->capture_default_str();
+  cmd->add_option("--instances", options->instances,
+                  "also N instances of the bunny in an rtcl::Scene against Embree's instanced scene: the "
+                  "top-level commit and the primary rays of a camera over them (first device; 0: none)")
+      ->check(integer_in(0, 10000000))
       ->capture_default_str();
   cmd->add_option("--scenes-dir", options->scenes_dir,
                   "directory of the shared meshes (default: $RTCL_SCENES_DIR; no other default)");

@@ -32,6 +32,7 @@ struct BenchOptions {
   // sort (AccelConfig::scattered_sort): measured, always or never.
   std::string diffuse_sort = "measured";
   unsigned embree_threads = std::max(1u, std::thread::hardware_concurrency());
+  int instances = 0;  // --instances: bunny instances of the instanced-scene section; 0: none
 };
 
 // Every input of a run, checked before the first OpenCL call.
@@ -39,6 +40,7 @@ struct BenchMatrix {
   std::vector<std::string> accels;
   std::vector<BenchSceneSpec> scenes;
   std::vector<int> kinds;  // 0 primary, 1 shadow, 2 diffuse
+  std::string scenes_dir;  // --scenes-dir, else $RTCL_SCENES_DIR
   Precision precision = Precision::robust;
   ScatteredSort diffuse_sort = ScatteredSort::measured;  // BenchOptions::diffuse_sort
   std::string json_path, md_path;

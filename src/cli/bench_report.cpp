@@ -147,6 +147,29 @@ std::string bench_json(const BenchRun& run) {
     for (const BenchBaseline& b : run.embree) baselines.push_back(baseline_json(b));
     embree = {{"version", run.embree_version}, {"flags", run.embree_flags}, {"baselines", baselines}};
   }
+  json instances = json::array();
+  for (const BenchInstances& i : run.instances) {
+    json embree_part = nullptr;
+    if (!i.embree_commit_ms.empty())
+      embree_part = {{"threads", i.embree_threads},
+                     {"child_commit_ms", i.embree_child_ms},
+                     {"setup_ms", spread_json(spread_of(i.embree_setup_ms))},
+                     {"commit_ms", spread_json(spread_of(i.embree_commit_ms))},
+                     {"commit_ms_runs", i.embree_commit_ms},
+                     {"trace_ms", spread_json(spread_of(i.embree_trace_ms))},
+                     {"trace_ms_runs", i.embree_trace_ms},
+                     {"agreeing", i.agreeing}};
+    instances.push_back({{"mesh", i.mesh},
+                         {"instances", i.instances},
+                         {"rays", i.ray_count},
+                         {"device_bytes", i.device_bytes},
+                         {"bottom_commit_ms", i.bottom_commit_ms},
+                         {"commit_ms", spread_json(spread_of(i.commit_ms))},
+                         {"commit_ms_runs", i.commit_ms},
+                         {"trace_ms", spread_json(spread_of(i.trace_ms))},
+                         {"trace_ms_runs", i.trace_ms},
+                         {"embree", embree_part}});
+  }
   json out = {
       {"schema", "rtcl-bench/1"},
       {"rtcl", {{"version", run.rtcl_version}, {"commit", run.rtcl_commit}}},
@@ -161,6 +184,7 @@ std::string bench_json(const BenchRun& run) {
       {"scenes", scenes},
       {"cells", cells},
       {"embree", embree},
+      {"instances", instances},
   };
   return out.dump(2) + "\n";
 }
@@ -288,6 +312,29 @@ std::string bench_markdown(const BenchRun& run) {
         md += "| " + scene + " | " + api + " |" + format(" %.1f |", first->build_ms) + format(" %.1f |", per_prim) +
               row + " " + check + " |\n";
       }
+  }
+  for (const BenchInstances& i : run.instances) {
+    const bool embree = !i.embree_commit_ms.empty();
+    const double commit = spread_of(i.commit_ms).median, trace = spread_of(i.trace_ms).median;
+    md += "\n### " + std::to_string(i.instances) + " instances of " + i.mesh + " (rtcl::Scene" +
+          (embree ? " against Embree's instanced scene, " + std::to_string(i.embree_threads) + " threads" : "") +
+          ")\n\n| | rtcl | Embree | rtcl / Embree |\n|---|---:|---:|---:|\n";
+    const double embree_commit = embree ? spread_of(i.embree_commit_ms).median : 0.0;
+    const double embree_trace = embree ? spread_of(i.embree_trace_ms).median : 0.0;
+    const auto ratio = [](double a, double b) { return b > 0.0 ? format(" %.2f |", a / b) : std::string(" - |"); };
+    md += "| top-level commit ms |" + format(" %.2f |", commit) +
+          (embree ? format(" %.2f |", embree_commit) : std::string(" - |")) + ratio(commit, embree_commit) + "\n";
+    md += "| primary rays Mrays/s |" + format(" %.1f |", static_cast<double>(i.ray_count) / (trace * 1e3)) +
+          (embree ? format(" %.1f |", static_cast<double>(i.ray_count) / (embree_trace * 1e3)) : std::string(" - |")) +
+          ratio(embree_trace, trace) + "\n";
+    md += format("\nrtcl: first commit (bottom level) %.1f ms, ", i.bottom_commit_ms) +
+          format("%.1f MB on the device", static_cast<double>(i.device_bytes) / 1e6);
+    if (embree)
+      md += format("; Embree: child scene commit %.1f ms, ", i.embree_child_ms) +
+            format("instance setup %.2f ms; ", spread_of(i.embree_setup_ms).median) +
+            format("same instance and triangle on %.2f%% of rays",
+                   100.0 * static_cast<double>(i.agreeing) / static_cast<double>(std::max<std::size_t>(i.ray_count, 1)));
+    md += ".\n";
   }
   return md;
 }

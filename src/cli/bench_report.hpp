@@ -96,6 +96,22 @@ struct BenchSceneInfo {
   std::size_t primary = 0, shadow = 0, diffuse = 0;  // rays in each set
 };
 
+// `--instances N` (bench_instances.hpp): N instances of one mesh in an
+// rtcl::Scene against Embree's instanced scene (one child scene, N
+// RTC_GEOMETRY_TYPE_INSTANCE geometries), on the run's first device.
+struct BenchInstances {
+  std::string mesh;  // the instanced mesh's scene name (bunny)
+  std::size_t instances = 0, ray_count = 0, device_bytes = 0;
+  double bottom_commit_ms = 0.0;      // rtcl's first commit: the bottom level and a first top level
+  std::vector<double> commit_ms;      // top-level commits after every instance moved (CommitStats::build_ms)
+  std::vector<double> trace_ms;       // Scene::trace of the forest camera's primary rays, wall until the kernel ends
+  double embree_child_ms = 0.0;       // the child scene's rtcCommitScene, timed apart
+  std::vector<double> embree_setup_ms, embree_commit_ms;  // the instance geometries' setup; rtcCommitScene
+  std::vector<double> embree_trace_ms;  // rtcIntersect1 of the same rays, right after each of rtcl's traces
+  unsigned embree_threads = 0;
+  std::size_t agreeing = 0;  // rays with the same instance and triangle in both, or a miss in both
+};
+
 struct BenchRun {
   std::string rtcl_version, rtcl_commit, host_cpu, started_utc, pocl_cache_dir;
   unsigned host_threads = 0;
@@ -110,6 +126,7 @@ struct BenchRun {
   std::vector<BenchCell> cells;
   std::string embree_version;  // "" when the run has no Embree baseline
   std::vector<BenchBaseline> embree;
+  std::vector<BenchInstances> instances;  // empty unless --instances was given
 };
 
 // The Embree baseline a cell is compared with (same scene and rays, packets

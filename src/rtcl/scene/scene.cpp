@@ -90,6 +90,9 @@ struct Scene::State {
   std::size_t live_instances = 0;
   bool instances_changed = false;
   std::size_t bottom_levels_built = 0, bottom_levels_refitted = 0, top_levels_built = 0;
+  // The commit's instances as the top level takes them: kept between
+  // commits, so that a commit writes pages it has written before.
+  std::vector<PlacedInstance> placed;
 
   // The published commit (the pointer alone is guarded).
   mutable std::mutex committed_mutex;
@@ -362,11 +365,14 @@ CommitStats Scene::commit() {
           bottoms = refit_bottoms(st.device, *previous->two_level->bottoms(), previous->bottom_meshes,
                                   next->bottom_meshes, refitted);
         if (!bottoms) bottoms = std::make_shared<const DeviceBottoms>(upload_bottoms(st.device, next->bottom_meshes));
-        std::vector<PlacedInstance> placed;
+        std::vector<PlacedInstance>& placed = st.placed;
+        placed.clear();
         placed.reserve(live.size());
+        auto last = bottom_of.end();  // instances of one mesh come in runs: one map search per run
         for (std::uint32_t i : live) {
           const Instance& in = *st.instances[i];
-          placed.push_back({bottom_of.at(in.mesh.value), in.transform, in.at_close, user_id(i)});
+          if (last == bottom_of.end() || last->first != in.mesh.value) last = bottom_of.find(in.mesh.value);
+          placed.push_back({last->second, in.transform, in.at_close, user_id(i)});
         }
         next->two_level =
             std::make_shared<const TwoLevel>(st.device, st.config.precision, std::move(bottoms), next->bottom_meshes,

@@ -28,29 +28,38 @@ double magnitude(const Aabb& b) {
   return std::max({m.x, m.y, m.z});
 }
 
-// The box of `boxes`' corners under x -> a x + t, grown into [lower,
-// upper] (double): a box of centre c and half extent e maps to the box of
-// centre a c + t and half extent |a| e (Arvo 1990, "Transforming axis-
-// aligned bounding boxes"), the box of its eight transformed corners.
-void grow_transformed(const std::vector<Aabb>& boxes, const glm::dmat3& a, const glm::dvec3& t, glm::dvec3& lower,
-                      glm::dvec3& upper) {
-  glm::dmat3 magnitude;
-  for (int col = 0; col < 3; ++col) magnitude[col] = glm::abs(a[col]);
-  for (const Aabb& b : boxes) {
-    const glm::dvec3 lo(b.lower), hi(b.upper);
-    const glm::dvec3 centre = a * (0.5 * (lo + hi)) + t, half = magnitude * (0.5 * (hi - lo));
-    lower = glm::min(lower, centre - half);
-    upper = glm::max(upper, centre + half);
+// Grows [lower, upper] by the boxes of `roots` under the transform x ->
+// A x + T (float, m row-major): per output axis i, T_i plus for each j the
+// lesser (greater) of A_ij lower_j and A_ij upper_j, the bound of the
+// box's eight corners (Arvo 1990, "Transforming axis-aligned bounding
+// boxes"). Each bound is pushed out by 2^-20 (16 float ulps) of the sum of
+// its four terms' magnitudes, more than the rounding of the products, of
+// the sum (together at most about 4 ulps of that sum; Higham 2002,
+// "Accuracy and stability of numerical algorithms", 4.2) and of the
+// margin's subtraction: the float box contains the exact image. The
+// eight lanes are the root's children (padded with copies of the first);
+// the loops over them vectorise.
+void grow_transformed(const RootBoxes& roots, const Transform& m, glm::vec3& lower, glm::vec3& upper) {
+  for (int i = 0; i < 3; ++i) {
+    float lo[RTCL_BLOCK_WIDTH], hi[RTCL_BLOCK_WIDTH];
+    const float t = m.m[i][3];
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+      float l = t, h = t, size = std::abs(t);
+      for (int j = 0; j < 3; ++j) {
+        const float p = m.m[i][j] * roots.lower[j][lane], q = m.m[i][j] * roots.upper[j][lane];
+        l += std::min(p, q);
+        h += std::max(p, q);
+        size += std::max(std::abs(p), std::abs(q));
+      }
+      const float margin = size * 0x1p-20f;
+      lo[lane] = l - margin;
+      hi[lane] = h + margin;
+    }
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+      lower[i] = std::min(lower[i], lo[lane]);
+      upper[i] = std::max(upper[i], hi[lane]);
+    }
   }
-}
-
-float round_down(double x) {
-  float f = static_cast<float>(x);
-  return static_cast<double>(f) > x ? std::nextafter(f, -INFINITY) : f;
-}
-float round_up(double x) {
-  float f = static_cast<float>(x);
-  return static_cast<double>(f) < x ? std::nextafter(f, INFINITY) : f;
 }
 
 // Records of an instance: `record` always, `motion` for a moving one.
@@ -89,78 +98,103 @@ InstanceMotion motion_record(const PlacedInstance& p) {
   return m;
 }
 
-// One wide node while the top level is collapsed: binary nodes (inner, or a
-// one-instance leaf) as its children.
+// A node whose eight slots are empty.
+Bvh8Node empty_node() {
+  Bvh8Node n;
+  for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+    for (int axis = 0; axis < 3; ++axis) {
+      n.bounds[axis][lane] = INFINITY;
+      n.bounds[3 + axis][lane] = -INFINITY;
+    }
+    n.child[lane] = RTCL_CHILD_EMPTY;
+  }
+  return n;
+}
+
+// The 8-wide top level collapsed from the binary SAH tree (leaves of up to
+// eight instances). A wide node's lanes are items: an instance, or a
+// binary node (inner, or a leaf of several instances) that becomes a wide
+// node of its own below. A node starts as its binary node opened and
+// greedily opens the item of largest area that still fits: an inner node
+// into its two children, a leaf into its instances. Fixed-size arrays
+// alone: a commit of 100k instances forms some 20k nodes.
 struct TopCollapse {
   const BuildTree& tree;
-  TopLevel out;
+  std::span<const Aabb> boxes;  // the instances' world boxes
+  TopLevel& out;
+
+  struct Item {
+    std::uint32_t index;  // instance, or binary node
+    bool instance;
+  };
+
+  Item item_of(std::uint32_t binary) const {
+    const BuildNode& n = tree.nodes[binary];
+    return n.is_leaf() && n.count == 1 ? Item{tree.prims[n.first], true} : Item{binary, false};
+  }
 
   // Forms the wide node `index` from binary node `binary`; `stack` is the
   // entries its ancestors leave on the traversal stack.
   void form(std::uint32_t binary, std::size_t index, std::uint32_t stack) {
-    std::vector<std::uint32_t> children;
-    const BuildNode& root = tree.nodes[binary];
-    if (root.is_leaf()) {
-      children.push_back(binary);
-    } else {
-      children = {root.child[0], root.child[1]};
-      // Greedy: open the inner child of largest area until eight children.
-      while (children.size() < RTCL_BLOCK_WIDTH) {
-        int best = -1;
-        float best_area = -1.0f;
-        for (std::size_t k = 0; k < children.size(); ++k) {
-          const BuildNode& c = tree.nodes[children[k]];
-          if (!c.is_leaf() && c.bounds.area() > best_area) {
-            best = static_cast<int>(k);
-            best_area = c.bounds.area();
-          }
-        }
-        if (best < 0) break;
-        const BuildNode& opened = tree.nodes[children[static_cast<std::size_t>(best)]];
-        children[static_cast<std::size_t>(best)] = opened.child[0];
-        children.push_back(opened.child[1]);
-      }
-    }
-    const auto count = static_cast<std::uint32_t>(children.size());
-    out.stack_size = std::max(out.stack_size, stack + count);
-    std::vector<std::pair<std::uint32_t, std::size_t>> below;
-    for (std::uint32_t lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
-      Bvh8Node& node = out.nodes[index];
-      if (lane >= count) {
-        node.child[lane] = RTCL_CHILD_EMPTY;
-        continue;
-      }
-      const BuildNode& c = tree.nodes[children[lane]];
-      for (int axis = 0; axis < 3; ++axis) {
-        node.bounds[axis][lane] = c.bounds.lower[axis];
-        node.bounds[3 + axis][lane] = c.bounds.upper[axis];
-      }
-      if (c.is_leaf()) {
-        node.child[lane] = ~static_cast<rtcl_i32>(tree.prims[c.first]);
+    Item items[RTCL_BLOCK_WIDTH];
+    std::uint32_t count = 1;
+    items[0] = {binary, false};
+    const auto open = [&](std::uint32_t k) {
+      const BuildNode& n = tree.nodes[items[k].index];
+      if (n.is_leaf()) {
+        items[k] = {tree.prims[n.first], true};
+        for (std::uint32_t p = 1; p < n.count; ++p) items[count++] = {tree.prims[n.first + p], true};
       } else {
-        node.child[lane] = static_cast<rtcl_i32>(out.nodes.size());
-        below.emplace_back(children[lane], out.nodes.size());
-        out.nodes.push_back(empty_node());
+        items[count++] = item_of(n.child[1]);
+        items[k] = item_of(n.child[0]);
+      }
+    };
+    for (int best = 0; best >= 0;) {
+      open(static_cast<std::uint32_t>(best));
+      best = -1;
+      float best_area = -1.0f;
+      for (std::uint32_t k = 0; k < count; ++k) {
+        if (items[k].instance) continue;
+        const BuildNode& n = tree.nodes[items[k].index];
+        const std::uint32_t grows = n.is_leaf() ? n.count - 1 : 1;
+        if (count + grows <= RTCL_BLOCK_WIDTH && n.bounds.area() > best_area) {
+          best = static_cast<int>(k);
+          best_area = n.bounds.area();
+        }
       }
     }
-    for (const auto& [child, child_index] : below) form(child, child_index, stack + count - 1);
-  }
-
-  static Bvh8Node empty_node() {
-    Bvh8Node n;
-    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+    out.stack_size = std::max(out.stack_size, stack + count);
+    const std::size_t first_below = out.nodes.size();
+    std::uint32_t below[RTCL_BLOCK_WIDTH];
+    std::uint32_t below_count = 0;
+    Bvh8Node& node = out.nodes[index];
+    for (std::uint32_t lane = 0; lane < count; ++lane) {
+      const Item& item = items[lane];
+      const Aabb& box = item.instance ? boxes[item.index] : tree.nodes[item.index].bounds;
       for (int axis = 0; axis < 3; ++axis) {
-        n.bounds[axis][lane] = INFINITY;
-        n.bounds[3 + axis][lane] = -INFINITY;
+        node.bounds[axis][lane] = box.lower[axis];
+        node.bounds[3 + axis][lane] = box.upper[axis];
       }
-      n.child[lane] = RTCL_CHILD_EMPTY;
+      if (item.instance) {
+        node.child[lane] = ~static_cast<rtcl_i32>(item.index);
+      } else {
+        node.child[lane] = static_cast<rtcl_i32>(first_below + below_count);
+        below[below_count++] = item.index;
+      }
     }
-    return n;
+    out.nodes.resize(first_below + below_count, empty_node());
+    for (std::uint32_t b = 0; b < below_count; ++b) form(below[b], first_below + b, stack + count - 1);
   }
 };
 
-// Instances per host thread in the pass over them (parallel.hpp).
-constexpr std::size_t kInstancesPerPart = 4096;
+
+// Instances per host thread in the pass over them and in the top level's
+// build (parallel.hpp): below some 30k instances the whole top level takes
+// a few milliseconds on one thread, and a hand-off to a pooled thread that
+// is asleep (after set_transform calls, a commit's threads have slept) or
+// not running (a busy host) can cost as much as the work; larger scenes
+// gain from the threads.
+constexpr std::size_t kInstancesPerPart = 32768;
 
 // The top level's RTCL_TOP_STACK_SIZE: a power of two, at least 64, so
 // that commits of a changing top level reuse one compiled program.
@@ -209,12 +243,24 @@ std::string motion_problem(const Transform& open, const Transform& close) {
   return "";
 }
 
-Aabb instance_world_box(const MeshBuild& mesh, const Transform& transform, const std::optional<Transform>& at_close) {
-  glm::dvec3 lower(INFINITY), upper(-INFINITY);
-  grow_transformed(mesh.root_boxes, linear_part(transform), translation_part(transform), lower, upper);
-  if (at_close) grow_transformed(mesh.root_boxes, linear_part(*at_close), translation_part(*at_close), lower, upper);
-  Aabb box{{round_down(lower.x), round_down(lower.y), round_down(lower.z)},
-           {round_up(upper.x), round_up(upper.y), round_up(upper.z)}};
+RootBoxes root_boxes_of(const MeshBuild& mesh) {
+  RootBoxes r;
+  const std::size_t count = mesh.root_boxes.size();
+  for (std::size_t lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+    // a mesh without boxes places the point at its origin
+    const Aabb box = count == 0 ? Aabb{glm::vec3(0.0f), glm::vec3(0.0f)} : mesh.root_boxes[lane < count ? lane : 0];
+    for (int axis = 0; axis < 3; ++axis) {
+      r.lower[axis][lane] = box.lower[axis];
+      r.upper[axis][lane] = box.upper[axis];
+    }
+  }
+  return r;
+}
+
+Aabb instance_world_box(const RootBoxes& roots, const Transform& transform, const std::optional<Transform>& at_close) {
+  Aabb box;  // empty
+  grow_transformed(roots, transform, box.lower, box.upper);
+  if (at_close) grow_transformed(roots, *at_close, box.lower, box.upper);
   const auto widen = static_cast<float>(kInstanceBoxWiden * magnitude(box));
   box.lower -= glm::vec3(widen);
   box.upper += glm::vec3(widen);
@@ -223,22 +269,27 @@ Aabb instance_world_box(const MeshBuild& mesh, const Transform& transform, const
 
 TopLevel build_top_level(std::span<const Aabb> world_boxes) {
   TopLevel top;
-  top.nodes.push_back(TopCollapse::empty_node());
-  if (world_boxes.empty()) {
-    top.stack_size = 1;
-    return top;
-  }
+  build_top_level(world_boxes, top);
+  return top;
+}
+
+void build_top_level(std::span<const Aabb> world_boxes, TopLevel& top) {
+  top.nodes.clear();
+  top.nodes.push_back(empty_node());
+  top.stack_size = 1;
+  if (world_boxes.empty()) return;
   std::vector<std::uint32_t> ids(world_boxes.size());
   for (std::size_t i = 0; i < ids.size(); ++i) ids[i] = static_cast<std::uint32_t>(i);
+  // Leaves of up to eight instances, each opened into the lanes of one
+  // wide node (TopCollapse).
   SahConfig sah;
-  sah.max_leaf_size = 1;
+  sah.thread_count = part_count(world_boxes.size(), 0, kInstancesPerPart);
   BuildTree tree = build_sah(world_boxes, ids, sah);
-  TopCollapse collapse{tree, std::move(top)};
-  collapse.form(0, 0, 0);
-  if (collapse.out.stack_size > kBvhMaxStackSize)
-    throw Error("Scene::commit: the top level needs a traversal stack of " + std::to_string(collapse.out.stack_size) +
+  top.stack_size = 0;
+  TopCollapse{tree, world_boxes, top}.form(0, 0, 0);
+  if (top.stack_size > kBvhMaxStackSize)
+    throw Error("Scene::commit: the top level needs a traversal stack of " + std::to_string(top.stack_size) +
                 " entries, more than " + std::to_string(kBvhMaxStackSize));
-  return std::move(collapse.out);
 }
 
 DeviceBottoms upload_bottoms(const Device& device, std::span<const std::shared_ptr<const MeshBuild>> meshes) {
@@ -270,7 +321,7 @@ DeviceBottoms upload_bottoms(const Device& device, std::span<const std::shared_p
     all_triangles.insert(all_triangles.end(), bvh.blocks.triangles.begin(), bvh.blocks.triangles.end());
     all_spheres.insert(all_spheres.end(), bvh.blocks.spheres.begin(), bvh.blocks.spheres.end());
   }
-  if (all_nodes.empty()) all_nodes.push_back(TopCollapse::empty_node());
+  if (all_nodes.empty()) all_nodes.push_back(empty_node());
   if (all_triangles.empty()) all_triangles.push_back(empty_triangle_block());
   if (all_spheres.empty()) all_spheres.push_back(empty_sphere_block());
   if (levels.empty()) levels.push_back({});
@@ -289,34 +340,46 @@ TwoLevel::TwoLevel(const Device& device, Precision precision, std::shared_ptr<co
                    std::span<const std::shared_ptr<const MeshBuild>> meshes, std::span<const PlacedInstance> instances,
                    const TwoLevel* previous)
     : device_(device), bottoms_(std::move(bottoms)) {
+  scratch_ = previous ? previous->scratch_ : std::make_shared<TopScratch>();
+  TopScratch& scratch = *scratch_;
   // Moving instance i's motion record is the number of moving ones before it.
-  std::vector<std::uint32_t> motion_index(instances.size());
+  std::vector<std::uint32_t>& motion_index = scratch.motion_index;
+  motion_index.resize(instances.size());
   std::uint32_t moving = 0;
   for (std::size_t i = 0; i < instances.size(); ++i) {
     motion_index[i] = moving;
     moving += instances[i].at_close ? 1 : 0;
   }
-  std::vector<Aabb> boxes(instances.size());
-  std::vector<InstanceRecord> records(instances.size());
-  std::vector<InstanceMotion> motions(moving);
+  std::vector<RootBoxes> roots;
+  for (const auto& mesh : meshes) roots.push_back(root_boxes_of(*mesh));
+  std::vector<Aabb>& boxes = scratch.boxes;
+  std::vector<InstanceRecord>& records = scratch.records;
+  std::vector<InstanceMotion>& motions = scratch.motions;
+  boxes.resize(instances.size());
+  records.resize(instances.size());
+  motions.resize(moving);
   for_each_part(instances.size(), part_count(instances.size(), 0, kInstancesPerPart),
                 [&](unsigned, std::size_t begin, std::size_t end) {
                   for (std::size_t i = begin; i < end; ++i) {
                     const PlacedInstance& p = instances[i];
-                    boxes[i] = instance_world_box(*meshes[p.bottom], p.transform, p.at_close);
+                    boxes[i] = instance_world_box(roots[p.bottom], p.transform, p.at_close);
                     records[i] = instance_record(p, motion_index[i]);
                     if (p.at_close) motions[motion_index[i]] = motion_record(p);
                   }
                 });
   moving_ = moving > 0;
-  TopLevel top = build_top_level(boxes);
+  TopLevel& top = scratch.top;
+  build_top_level(boxes, top);
   if (records.empty()) records.push_back({});
   if (motions.empty()) motions.push_back({});
   bytes_ = top.nodes.size() * sizeof(Bvh8Node) + records.size() * sizeof(InstanceRecord) +
            motions.size() * sizeof(InstanceMotion);
   top_ = device.upload(top.nodes.data(), top.nodes.size() * sizeof(Bvh8Node), "scene top-level nodes");
   instances_ = device.upload(records.data(), records.size() * sizeof(InstanceRecord), "scene instances");
-  motions_ = device.upload(motions.data(), motions.size() * sizeof(InstanceMotion), "scene instance motions");
+  if (!moving_ && previous && !previous->moving_)  // both the one-record placeholder, never written
+    motions_ = previous->motions_;
+  else
+    motions_ = device.upload(motions.data(), motions.size() * sizeof(InstanceMotion), "scene instance motions");
   if (previous) {  // read only (times) and never written (ids): shared
     no_times_ = previous->no_times_;
     no_ids_ = previous->no_ids_;
@@ -330,6 +393,7 @@ TwoLevel::TwoLevel(const Device& device, Precision precision, std::shared_ptr<co
               "RTCL_TOP_STACK_SIZE=" + std::to_string(top_kernel_stack_size(top.stack_size))};
   if (bottoms_->spheres_present) defines_.push_back("RTCL_HAS_SPHERES");
   if (moving_) defines_.push_back("RTCL_INSTANCES_MOVING");
+  if (instances.size() == 1) defines_.push_back("RTCL_TOP_ONE_INSTANCE");
   for (std::string& option : precision_build_options(precision)) defines_.push_back(std::move(option));
   if (previous && previous->defines_ == defines_) {
     std::lock_guard lock(previous->mutex_);

@@ -69,13 +69,23 @@ std::string transform_problem(const Transform& transform);
 // [0, 1].
 std::string motion_problem(const Transform& open, const Transform& close);
 
-// The world box of `mesh` placed by the instance: the outward-rounded box
-// of its root boxes' corners under the transform (both transforms of a
-// moving one: every point moves on a straight line between them), widened
-// by kInstanceBoxWiden of its coordinates' magnitude for the rounding of
-// the object-space ray (docs/scenes-and-instances.md, "Precision").
+// A mesh's root boxes (MeshBuild::root_boxes) in eight float lanes per
+// bound, lanes beyond them copies of the first: the form the pass over the
+// instances transforms.
+struct RootBoxes {
+  float lower[3][RTCL_BLOCK_WIDTH];
+  float upper[3][RTCL_BLOCK_WIDTH];
+};
+RootBoxes root_boxes_of(const MeshBuild& mesh);
+
+// The world box of a mesh (its root boxes) placed by the instance: a box
+// holding its root boxes' corners under the transform (both transforms of
+// a moving one: every point moves on a straight line between them),
+// computed in float with a margin for its rounding, and widened by
+// kInstanceBoxWiden of its coordinates' magnitude for the rounding of the
+// object-space ray (docs/scenes-and-instances.md, "Precision").
 inline constexpr double kInstanceBoxWiden = 64.0 * 5.9604644775390625e-8;  // 64 float ulps (2^-24 each)
-Aabb instance_world_box(const MeshBuild& mesh, const Transform& transform, const std::optional<Transform>& at_close);
+Aabb instance_world_box(const RootBoxes& roots, const Transform& transform, const std::optional<Transform>& at_close);
 
 // The top level over instances: the 8-wide tree (child references: inner
 // node >= 0, instance k as ~k, RTCL_CHILD_EMPTY) and its stack bound, the
@@ -85,6 +95,22 @@ struct TopLevel {
   std::uint32_t stack_size = 0;
 };
 TopLevel build_top_level(std::span<const Aabb> world_boxes);
+// The same into `top`, whose arrays' room is reused.
+void build_top_level(std::span<const Aabb> world_boxes, TopLevel& top);
+
+// The host arrays of a top-level build, handed from one commit's TwoLevel
+// to the next (a scene's commits run one at a time) so that a commit
+// writes into pages it wrote before: on a virtual machine, faulting fresh
+// pages in was a quarter of a commit of 100k instances. They hold the last
+// build's intermediates (some 130 bytes per instance) and nothing a query
+// reads.
+struct TopScratch {
+  std::vector<std::uint32_t> motion_index;
+  std::vector<Aabb> boxes;
+  std::vector<InstanceRecord> records;
+  std::vector<InstanceMotion> motions;
+  TopLevel top;
+};
 
 // One commit's two-level structure on the device.
 class TwoLevel {
@@ -92,7 +118,8 @@ class TwoLevel {
   // Uploads the instances (records, motions, top level) over `bottoms`
   // (shared with other commits over the same meshes) and builds the
   // closest-hit program, or takes the programs of `previous` (the last
-  // commit's, when it has one) where they were built with the same options.
+  // commit's, when it has one) where they were built with the same options,
+  // and its TopScratch.
   TwoLevel(const Device& device, Precision precision, std::shared_ptr<const DeviceBottoms> bottoms,
            std::span<const std::shared_ptr<const MeshBuild>> meshes, std::span<const PlacedInstance> instances,
            const TwoLevel* previous = nullptr);
@@ -114,6 +141,7 @@ class TwoLevel {
 
   Device device_;
   std::shared_ptr<const DeviceBottoms> bottoms_;
+  std::shared_ptr<TopScratch> scratch_;  // written by constructors alone
   cl::Buffer top_, instances_, motions_, no_times_, no_ids_;
   std::vector<std::string> defines_;
   std::size_t bytes_ = 0;
