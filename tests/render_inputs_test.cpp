@@ -71,13 +71,14 @@ TEST(RenderInputs, CameraRaysThroughTheCornersAndCentre) {
 SceneMesh unit_cube(glm::dmat4 transform) {
   SceneMesh m;
   m.name = "cube";
-  for (int i = 0; i < 8; ++i) m.vertices.push_back({i & 1 ? 1.0f : 0.0f, i & 2 ? 1.0f : 0.0f, i & 4 ? 1.0f : 0.0f});
+  MeshShape& shape = m.edit_shape();
+  for (int i = 0; i < 8; ++i) shape.vertices.push_back({i & 1 ? 1.0f : 0.0f, i & 2 ? 1.0f : 0.0f, i & 4 ? 1.0f : 0.0f});
   const unsigned quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
   for (const auto& q : quads) {
-    m.triangles.push_back({q[0], q[1], q[2]});
-    m.triangles.push_back({q[0], q[2], q[3]});
+    shape.triangles.push_back({q[0], q[1], q[2]});
+    shape.triangles.push_back({q[0], q[2], q[3]});
   }
-  m.materials.assign(m.triangles.size(), 0);
+  shape.materials.assign(shape.triangles.size(), 0);
   m.transform = transform;
   return m;
 }
@@ -152,9 +153,9 @@ TEST(RenderInputs, EmissiveTrianglesBecomeTriangleLightsByAreaShare) {
   // dark one; the emissive light's colour 0.5 and intensity 3.
   SceneMesh m;
   m.name = "emitters";
-  m.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 5}, {2, 0, 5}, {0, 2, 5}, {9, 9, 9}, {9, 9, 8}, {9, 8, 9}};
-  m.triangles = {{0, 1, 2}, {6, 7, 8}, {3, 4, 5}};
-  m.materials = {1, 0, 1};
+  m.edit_shape().vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 5}, {2, 0, 5}, {0, 2, 5}, {9, 9, 9}, {9, 9, 8}, {9, 8, 9}};
+  m.edit_shape().triangles = {{0, 1, 2}, {6, 7, 8}, {3, 4, 5}};
+  m.edit_shape().materials = {1, 0, 1};
   SceneDescription s = one_mesh_scene(m);
   Material glow;
   glow.emission = {2.0f, 4.0f, 8.0f};
