@@ -5,6 +5,7 @@
 #include <pybind11/stl.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -83,14 +84,18 @@ auto as_value_error(Fn&& fn) {
   }
 }
 
-// None: the built-in default scene; "default" or "showcase": that built-in
-// scene; anything else (a str or an os.PathLike): a scene file.
+// None: the built-in default scene; "default", "showcase" or "forest": that
+// built-in scene (the forest's bunny from $RTCL_SCENES_DIR, as rtcl render
+// reads it); anything else (a str or an os.PathLike): a scene file.
 SceneDescription read_scene(py::handle scene) {
   if (scene.is_none()) return builtin_scene("default");
   std::string path;
   if (py::isinstance<py::str>(scene)) {
     path = scene.cast<std::string>();
-    if (path == "default" || path == "showcase") return builtin_scene(path);
+    if (path == "default" || path == "showcase" || path == "forest") {
+      const char* scenes_dir = std::getenv("RTCL_SCENES_DIR");
+      return as_value_error([&] { return builtin_scene(path, scenes_dir ? scenes_dir : ""); });
+    }
   } else if (py::hasattr(scene, "__fspath__")) {
     path = py::str(scene.attr("__fspath__")()).cast<std::string>();
   } else {
@@ -99,7 +104,7 @@ SceneDescription read_scene(py::handle scene) {
   }
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
-    throw py::value_error("render: scene \"" + path + "\": no such file (built-in scenes: default, showcase)");
+    throw py::value_error("render: scene \"" + path + "\": no such file (built-in scenes: default, showcase, forest)");
   return as_value_error([&] { return load_scene(path); });
 }
 
@@ -221,8 +226,9 @@ void bind_render(py::module_& m) {
       R"doc(Renders a scene as `rtcl render` does and returns the image: (height, width, 3)
 float32, linear RGB, row 0 at the top.
 
-scene: None (the built-in default scene), "default" or "showcase" (built-in
-    scenes), or the path of a scene file (JSON, docs/file-formats.md).
+scene: None (the built-in default scene), "default", "showcase" or "forest"
+    (built-in scenes; the forest reads its bunny from $RTCL_SCENES_DIR), or
+    the path of a scene file (JSON, docs/file-formats.md).
 width, height: pixels (height None: width / the camera's aspect).
 spp: samples per pixel. depth: reflection/refraction bounces.
 sampler: "stratified", "random" or "sobol"; seed: of every sample pattern.

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import rtcl
+from meshes import scenes_dir
 
 
 def read_png(path):
@@ -73,8 +74,13 @@ def test_default_scene():
 @pytest.mark.parametrize("options", [
     dict(scene="showcase", width=40, height=30, spp=2, depth=3, sampler="sobol", seed=7, light_samples=2),
     dict(scene="default", width=40, height=32, spp=1, method="selective", selective_block=4),
+    dict(scene="forest", width=40, height=24, spp=1, depth=1),
 ])
-def test_same_image_as_the_command(tmp_path, options):
+def test_same_image_as_the_command(tmp_path, monkeypatch, options):
+    if options["scene"] == "forest":
+        if not (scenes_dir() / "stanford_bunny" / "bunny.obj").is_file():
+            pytest.skip("the forest's bunny is not in RTCL_SCENES_DIR")
+        monkeypatch.setenv("RTCL_SCENES_DIR", str(scenes_dir()))
     out = tmp_path / "image.png"
     args = [os.environ["RTCL_CLI"], "render", "-q", "-o", str(out)]
     for key, value in options.items():
@@ -90,7 +96,7 @@ def test_same_image_as_the_command(tmp_path, options):
     assert np.abs(srgb_bytes(other) - read_png(out).astype(np.int32)).max() > 8
 
 
-def test_bad_options():
+def test_bad_options(monkeypatch):
     with pytest.raises(ValueError, match=r"render: width is 0; must be in \[1, 65536\]"):
         rtcl.render(width=0)
     with pytest.raises(ValueError, match="render: spp is 0"):
@@ -103,6 +109,10 @@ def test_bad_options():
         rtcl.render(min_weight=float("nan"))
     with pytest.raises(ValueError, match='render: scene "no/such.json": no such file'):
         rtcl.render("no/such.json")
+    with monkeypatch.context() as m:
+        m.delenv("RTCL_SCENES_DIR", raising=False)
+        with pytest.raises(ValueError, match="RTCL_SCENES_DIR|scenes directory"):
+            rtcl.render("forest", width=8)
     with pytest.raises(TypeError, match="render: scene must be"):
         rtcl.render(3)
     with pytest.raises(ValueError, match='accel "nope"'):
