@@ -119,6 +119,18 @@ void finish_node(global Bvh8Node* nodes, uint n, float node_cost, global float* 
   *hi = h;
 }
 
+/* After writing its lane of node n: whether this work-item's write is the
+ * last of node n's arrivals[n] (then it finishes n, and the counter is
+ * back at 0 for the next refit). The fences order the lane writes before
+ * the count and the count before the reads of n's lanes. */
+inline bool last_to_arrive(global uint* counters, global const uint* arrivals, uint n) {
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  if (atomic_inc(counters + n) + 1 != arrivals[n]) return false;
+  counters[n] = 0;
+  mem_fence(CLK_GLOBAL_MEM_FENCE);
+  return true;
+}
+
 kernel void refit_bottom_up(global TriangleBlock* blocks, uint block_count, global const uint* lane_vertices,
                             global const float* vertices, global Bvh8Node* nodes, global const uint* up_blocks,
                             global const uint* up, global const uint* arrivals, global uint* counters,
@@ -132,10 +144,7 @@ kernel void refit_bottom_up(global TriangleBlock* blocks, uint block_count, glob
     const uint to = up_blocks[i];
     write_lane(nodes, to, lo, hi);
     n = to / RTCL_BLOCK_WIDTH;
-    mem_fence(CLK_GLOBAL_MEM_FENCE);
-    if (atomic_inc(counters + n) + 1 != arrivals[n]) return;
-    counters[n] = 0;
-    mem_fence(CLK_GLOBAL_MEM_FENCE);
+    if (!last_to_arrive(counters, arrivals, n)) return;
   } else if (i < block_count + start_count) {
     n = start_nodes[i - block_count];
   } else {
@@ -147,9 +156,6 @@ kernel void refit_bottom_up(global TriangleBlock* blocks, uint block_count, glob
     if (to == RTCL_REFIT_ROOT) return;
     write_lane(nodes, to, lo, hi);
     n = to / RTCL_BLOCK_WIDTH;
-    mem_fence(CLK_GLOBAL_MEM_FENCE);
-    if (atomic_inc(counters + n) + 1 != arrivals[n]) return;
-    counters[n] = 0;
-    mem_fence(CLK_GLOBAL_MEM_FENCE);
+    if (!last_to_arrive(counters, arrivals, n)) return;
   }
 }

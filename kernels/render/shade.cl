@@ -92,6 +92,20 @@ inline float3 motion_lerp3(global const float* a, global const float* b, float t
 #define MOTION_SURFACE_ARGS
 #endif
 
+#ifdef RTCL_HAS_SPHERES
+/* The hit h of ray r on the sphere of world centre c and radius `radius`:
+ * the hit point projected onto the sphere, its outward normal. */
+inline SurfacePoint sphere_surface_point(const Ray r, const Hit h, float3 c, float radius, uint material) {
+  SurfacePoint s;
+  float3 p = (float3)(r.ox, r.oy, r.oz) + h.t * (float3)(r.dx, r.dy, r.dz);
+  s.ng = normalize(p - c);
+  s.p = c + radius * s.ng;
+  s.offset = RTCL_SPAWN_OFFSET(s.p, radius);
+  s.material = material;
+  return s;
+}
+#endif
+
 inline SurfacePoint surface_point(const Ray r, const Hit h, global const ShadeTriangle* triangles,
                                   uint triangle_count, global const ShadeSphere* spheres MOTION_SURFACE_PARAMS) {
   SurfacePoint s;
@@ -106,12 +120,7 @@ inline SurfacePoint surface_point(const Ray r, const Hit h, global const ShadeTr
     float3 c = load3g(sp->center);
     float radius = sp->radius;
 #endif
-    float3 p = (float3)(r.ox, r.oy, r.oz) + h.t * (float3)(r.dx, r.dy, r.dz);
-    s.ng = normalize(p - c);
-    s.p = c + radius * s.ng;
-    s.offset = RTCL_SPAWN_OFFSET(s.p, radius);
-    s.material = sp->material;
-    return s;
+    return sphere_surface_point(r, h, c, radius, sp->material);
   }
 #endif
   global const ShadeTriangle* t = triangles + h.prim;
@@ -158,12 +167,7 @@ inline SurfacePoint instance_surface_point(const Ray r, const Hit h, uint k, glo
     global const ShadeSphere* sp = spheres + in->first_sphere + ((uint)h.prim - in->triangle_count);
     float3 c = instance_point(m, load3g(sp->center));
     float radius = sp->radius * length((float3)(m[0], m[4], m[8]));
-    float3 p = (float3)(r.ox, r.oy, r.oz) + h.t * (float3)(r.dx, r.dy, r.dz);
-    s.ng = normalize(p - c);
-    s.p = c + radius * s.ng;
-    s.offset = RTCL_SPAWN_OFFSET(s.p, radius);
-    s.material = sp->material;
-    return s;
+    return sphere_surface_point(r, h, c, radius, sp->material);
   }
 #endif
   global const ShadeTriangle* t = triangles + in->first_triangle + h.prim;
