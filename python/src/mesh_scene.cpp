@@ -193,44 +193,54 @@ std::unique_ptr<Scene> MeshScene::make_scene(const char* call) const {
   return std::make_unique<Scene>(device_, config);
 }
 
+MeshScene::FreshScene MeshScene::fresh_scene(const char* call, const Mesh* replacement, std::uint32_t replaced) const {
+  FreshScene fresh;
+  fresh.scene = make_scene(call);
+  fresh.meshes.resize(geometries_.size());
+  fresh.instances.resize(geometries_.size());
+  for (std::size_t g = 0; g < geometries_.size(); ++g) {
+    const Mesh& mesh = replacement && g == replaced ? *replacement : *geometries_[g].mesh;
+    add_to_scene(*fresh.scene, static_cast<std::uint32_t>(g), geometries_[g], mesh, fresh.meshes[g], fresh.instances[g]);
+  }
+  return fresh;
+}
+
+void MeshScene::adopt(FreshScene&& fresh) {
+  for (std::size_t g = 0; g < geometries_.size(); ++g) {
+    geometries_[g].scene_mesh = fresh.meshes[g];
+    for (std::size_t k = 0; k < geometries_[g].placements.size(); ++k)
+      placements_[geometries_[g].placements[k]].scene_instance = fresh.instances[g][k];
+  }
+  scene_ = std::move(fresh.scene);
+}
+
+void MeshScene::check_geometry(const char* call, std::uint32_t geometry) const {
+  if (geometry >= geometries_.size())
+    throw Error(std::string(call) + ": geometry_id " + std::to_string(geometry) + " does not exist (" +
+                (geometries_.empty() ? std::string("no geometry added yet")
+                                     : "geometry ids 0 to " + std::to_string(geometries_.size() - 1)) + ")");
+}
+
 std::uint32_t MeshScene::add_instance(std::uint32_t geometry, const Transform& transform) {
   const char* call = "add_instance";
   if (const std::string problem = transform_problem(transform); !problem.empty())
     throw Error(std::string(call) + ": " + problem);
   std::lock_guard lock(mutex_);
-  if (geometry >= geometries_.size())
-    throw Error(std::string(call) + ": geometry_id " + std::to_string(geometry) + " does not exist (" +
-                (geometries_.empty() ? std::string("no geometry added yet")
-                                     : "geometry ids 0 to " + std::to_string(geometries_.size() - 1)) + ")");
+  check_geometry(call, geometry);
   if (instance_placement_.size() >= 0x7fffffffu || placements_.size() >= kInvalidId - 1)
     throw Error(std::string(call) + ": the scene holds the most instances it can (2^31-1)");
   const auto instance = static_cast<std::uint32_t>(instance_placement_.size());
   const auto placement = static_cast<std::uint32_t>(placements_.size());
   // The scene, its meshes and the new instance: made aside, kept when
   // every step succeeded.
-  std::unique_ptr<Scene> fresh;
-  std::vector<std::optional<MeshId>> fresh_meshes;
-  std::vector<std::vector<std::optional<InstanceId>>> fresh_instances;
-  if (!scene_) {
-    fresh = make_scene(call);
-    fresh_meshes.resize(geometries_.size());
-    fresh_instances.resize(geometries_.size());
-    for (std::size_t g = 0; g < geometries_.size(); ++g)
-      add_to_scene(*fresh, static_cast<std::uint32_t>(g), geometries_[g], *geometries_[g].mesh, fresh_meshes[g], fresh_instances[g]);
-  }
-  Scene& scene = scene_ ? *scene_ : *fresh;
-  const std::optional<MeshId> mesh = scene_ ? geometries_[geometry].scene_mesh : fresh_meshes[geometry];
+  FreshScene fresh;
+  if (!scene_) fresh = fresh_scene(call);
+  Scene& scene = scene_ ? *scene_ : *fresh.scene;
+  const std::optional<MeshId> mesh = scene_ ? geometries_[geometry].scene_mesh : fresh.meshes[geometry];
   std::optional<InstanceId> added;
   if (mesh) added = scene.add_instance(Instance{*mesh, transform, std::nullopt, placement});
   // Nothing below throws but allocation.
-  if (fresh) {
-    for (std::size_t g = 0; g < geometries_.size(); ++g) {
-      geometries_[g].scene_mesh = fresh_meshes[g];
-      for (std::size_t k = 0; k < geometries_[g].placements.size(); ++k)
-        placements_[geometries_[g].placements[k]].scene_instance = fresh_instances[g][k];
-    }
-    scene_ = std::move(fresh);
-  }
+  if (fresh.scene) adopt(std::move(fresh));
   placements_.push_back({placement_of(geometry, instance, transform), added});
   geometries_[geometry].placements.push_back(placement);
   instance_placement_.push_back(placement);
@@ -259,10 +269,7 @@ void MeshScene::set_transform(std::uint32_t instance, const Transform& transform
 void MeshScene::update_vertices(std::uint32_t geometry, std::vector<glm::vec3> vertices) {
   const char* call = "update_vertices";
   std::lock_guard lock(mutex_);
-  if (geometry >= geometries_.size())
-    throw Error(std::string(call) + ": geometry_id " + std::to_string(geometry) + " does not exist (" +
-                (geometries_.empty() ? std::string("no geometry added yet")
-                                     : "geometry ids 0 to " + std::to_string(geometries_.size() - 1)) + ")");
+  check_geometry(call, geometry);
   GeometryEntry& entry = geometries_[geometry];
   if (vertices.size() != entry.mesh->vertices.size())
     throw Error(std::string(call) + ": vertex_positions has " + std::to_string(vertices.size()) +
@@ -273,16 +280,9 @@ void MeshScene::update_vertices(std::uint32_t geometry, std::vector<glm::vec3> v
   if (entry.mesh->hittable && !mesh->hittable)
     throw Error(std::string(call) + ": vertex_positions leave every triangle of geometry " + std::to_string(geometry) +
                 " with zero area (nothing to hit)");
-  std::unique_ptr<Scene> fresh;
-  std::vector<std::optional<MeshId>> fresh_meshes;
-  std::vector<std::vector<std::optional<InstanceId>>> fresh_instances;
+  FreshScene fresh;
   if (!scene_) {
-    fresh = make_scene(call);
-    fresh_meshes.resize(geometries_.size());
-    fresh_instances.resize(geometries_.size());
-    for (std::size_t g = 0; g < geometries_.size(); ++g)
-      add_to_scene(*fresh, static_cast<std::uint32_t>(g), geometries_[g], g == geometry ? *mesh : *geometries_[g].mesh, fresh_meshes[g],
-                   fresh_instances[g]);
+    fresh = fresh_scene(call, mesh.get(), geometry);
   } else if (entry.scene_mesh) {
     std::vector<float> xyz(3 * mesh->vertices.size());
     for (std::size_t v = 0; v < mesh->vertices.size(); ++v)
@@ -290,21 +290,14 @@ void MeshScene::update_vertices(std::uint32_t geometry, std::vector<glm::vec3> v
     scene_->update_vertices(*entry.scene_mesh, xyz);
   } else if (mesh->hittable) {
     // A mesh that had nothing to hit now has: into the scene with its placements.
-    fresh_meshes.resize(1);
-    fresh_instances.resize(1);
-    add_to_scene(*scene_, geometry, entry, *mesh, fresh_meshes[0], fresh_instances[0]);
-    entry.scene_mesh = fresh_meshes[0];
+    std::optional<MeshId> mesh_id;
+    std::vector<std::optional<InstanceId>> instance_ids;
+    add_to_scene(*scene_, geometry, entry, *mesh, mesh_id, instance_ids);
+    entry.scene_mesh = mesh_id;
     for (std::size_t k = 0; k < entry.placements.size(); ++k)
-      placements_[entry.placements[k]].scene_instance = fresh_instances[0][k];
+      placements_[entry.placements[k]].scene_instance = instance_ids[k];
   }
-  if (fresh) {
-    for (std::size_t g = 0; g < geometries_.size(); ++g) {
-      geometries_[g].scene_mesh = fresh_meshes[g];
-      for (std::size_t k = 0; k < geometries_[g].placements.size(); ++k)
-        placements_[geometries_[g].placements[k]].scene_instance = fresh_instances[g][k];
-    }
-    scene_ = std::move(fresh);
-  }
+  if (fresh.scene) adopt(std::move(fresh));
   entry.mesh = std::move(mesh);
   instanced_.store(true);
   built_.reset();

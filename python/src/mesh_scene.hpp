@@ -158,6 +158,19 @@ class MeshScene {
   // has nothing to hit); the ids go to `mesh` and `instances`.
   void add_to_scene(Scene& scene, std::uint32_t id, const GeometryEntry& g, const Mesh& mesh,
                     std::optional<MeshId>& mesh_id, std::vector<std::optional<InstanceId>>& instances) const;
+  // A Scene of every geometry and placement, made aside (geometry
+  // `replaced` with `replacement` when that is given), with the ids of
+  // each geometry's mesh and placements; adopt() makes it the scene's and
+  // throws only on allocation.
+  struct FreshScene {
+    std::unique_ptr<Scene> scene;
+    std::vector<std::optional<MeshId>> meshes;
+    std::vector<std::vector<std::optional<InstanceId>>> instances;
+  };
+  FreshScene fresh_scene(const char* call, const Mesh* replacement = nullptr, std::uint32_t replaced = 0) const;
+  void adopt(FreshScene&& fresh);
+  // Throws Error naming `call` when `geometry` is not a geometry id.
+  void check_geometry(const char* call, std::uint32_t geometry) const;
 
   Device device_;
   std::string accel_;
