@@ -220,16 +220,6 @@ TEST(Refit, ClosedMeshStaysLeakFreeAfterRefit) {
     }
 }
 
-// Two triangles side by side at z = 0 and one with its three corners on a
-// line (zero area, skipped by the build).
-Geometry with_a_degenerate_triangle() {
-  Geometry g;
-  g.source = "two quads' triangles and a degenerate one";
-  g.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 0, 0}, {3, 0, 0}, {4, 0, 0}};
-  g.triangles = {{0, 1, 2}, {1, 3, 2}, {4, 5, 6}};
-  return g;
-}
-
 TEST(Refit, ZeroAreaTriangleThatGainsAreaIsRefusedAndRebuilt) {
   const Device& device = test_device();
   const Geometry built = with_a_degenerate_triangle();

@@ -236,16 +236,6 @@ TEST(SceneRefit, InstancesOfRefittedMeshesAnswerForTheirNewVertices) {
   }
 }
 
-// Two triangles side by side at z = 0 and one with its three corners on a
-// line (zero area, skipped by the build).
-Geometry with_a_degenerate_triangle() {
-  Geometry g;
-  g.source = "two triangles and a degenerate one";
-  g.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 0, 0}, {3, 0, 0}, {4, 0, 0}};
-  g.triangles = {{0, 1, 2}, {1, 3, 2}, {4, 5, 6}};
-  return g;
-}
-
 // The refit has no place for a triangle that was skipped at the build: the
 // commit rebuilds, on either path, and the triangle is hit.
 TEST(SceneRefit, ATriangleThatGainsItsAreaIsRebuilt) {

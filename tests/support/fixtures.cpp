@@ -60,6 +60,14 @@ std::string scenes_dir() {
 
 std::string scene_path(const std::string& relative) { return scenes_dir() + "/" + relative; }
 
+Geometry with_a_degenerate_triangle() {
+  Geometry g;
+  g.source = "two triangles and a degenerate one";
+  g.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 0, 0}, {3, 0, 0}, {4, 0, 0}};
+  g.triangles = {{0, 1, 2}, {1, 3, 2}, {4, 5, 6}};
+  return g;
+}
+
 Geometry triangle_fan(int count) {
   Geometry g;
   g.source = "fan of " + std::to_string(count) + " triangles";

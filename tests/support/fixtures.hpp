@@ -45,6 +45,10 @@ Geometry random_soup(std::size_t count, std::uint32_t seed, float size = 0.05f, 
 // z = 0 (vertex 1 + i at angle 2 pi i / count).
 Geometry triangle_fan(int count);
 
+// Two triangles side by side at z = 0 and one with its three corners on a
+// line (zero area, skipped by the build; vertices 4, 5, 6).
+Geometry with_a_degenerate_triangle();
+
 // Rays from random points on a sphere around the geometry towards random
 // points inside its bounds.
 std::vector<Ray> random_rays(const Geometry& geometry, std::size_t count, std::uint32_t seed);
