@@ -25,6 +25,11 @@
 // The two refits are timed in one or both of two ways (--timing):
 //   interleaved  each of rtcl's refits right before one of Embree's, so
 //                that both see the same moments of a shared machine;
+//                --gap MS sleeps before each call (untimed): the threads of
+//                either library spin for a while after their work (Embree's
+//                TBB workers, rtcl's host pool), and without a gap they
+//                may take cores from the other's next call (with one, each
+//                call may wake its threads from sleep instead);
 //   blocks       all of rtcl's refits, then all of Embree's (each with its
 //                caches to itself, as an application refitting one mesh
 //                per frame has them).
@@ -36,7 +41,7 @@
 // threads (--threads).
 //
 //   rtcl_refit_bench [--scenes-dir DIR] [--scene bunny,dragon,soup] [--soup 1000000] [--size 512]
-//                    [--repeat 7] [--threads 2] [--timing interleaved,blocks]
+//                    [--repeat 7] [--threads 2] [--timing interleaved,blocks] [--gap 0]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -47,6 +52,7 @@
 #include <utility>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bench/support/ray_sets.hpp"
@@ -182,6 +188,7 @@ int main(int argc, char** argv) try {
   std::string scenes_dir = rtcl::bench::scenes_dir(), scenes = "bunny,dragon,soup", timing = "interleaved,blocks";
   std::size_t soup = 1000000;
   int size = 512, repeat = 7, threads = 2;
+  double gap_ms = 0.0;
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i];
     auto value = [&]() -> std::string {
@@ -195,9 +202,12 @@ int main(int argc, char** argv) try {
     else if (arg == "--repeat") repeat = std::stoi(value());
     else if (arg == "--threads") threads = std::stoi(value());
     else if (arg == "--timing") timing = value();
-    else throw rtcl::Error(arg + ": unknown option (--scenes-dir, --scene, --soup, --size, --repeat, --threads, --timing)");
+    else if (arg == "--gap") gap_ms = std::stod(value());
+    else throw rtcl::Error(arg + ": unknown option (--scenes-dir, --scene, --soup, --size, --repeat, --threads, --timing, --gap)");
   }
   if (size < 8 || repeat < 1 || threads < 1 || soup < 1) throw rtcl::Error("--size >= 8, --repeat, --threads, --soup >= 1");
+  if (!(gap_ms >= 0.0 && gap_ms <= 1000.0)) throw rtcl::Error("--gap: milliseconds in [0, 1000]");
+  const auto gap = std::chrono::duration<double, std::milli>(gap_ms);
   const std::vector<std::string> timings = split(timing);
   if (timings.empty()) throw rtcl::Error("--timing: empty (interleaved, blocks or both)");
   for (const std::string& t : timings)
@@ -291,9 +301,11 @@ int main(int argc, char** argv) try {
       if (timings[w] == "interleaved") {
         std::vector<double> refit_runs;
         auto [embree_ms, scene] = timed_commits(RTC_BUILD_QUALITY_REFIT, &block_first_ms, [&](int k) {
+          std::this_thread::sleep_for(gap);
           const auto start = Clock::now();
           refit(k);
           if (k > 0) refit_runs.push_back(ms_since(start));
+          std::this_thread::sleep_for(gap);
         });
         timed[w] = {median(refit_runs), embree_ms};
         refitted = std::move(scene);
