@@ -195,14 +195,27 @@ int main(int argc, char** argv) try {
       if (i + 1 >= argc) throw rtcl::Error(arg + ": needs a value");
       return argv[++i];
     };
+    // A numeric value: the whole text a number, else an error naming the flag.
+    auto number = [&]() -> double {
+      const std::string text = value();
+      std::size_t used = 0;
+      double x = 0.0;
+      try {
+        x = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != text.size()) throw rtcl::Error(arg + " " + text + ": not a number");
+      return x;
+    };
     if (arg == "--scenes-dir") scenes_dir = value();
     else if (arg == "--scene") scenes = value();
-    else if (arg == "--soup") soup = std::stoul(value());
-    else if (arg == "--size") size = std::stoi(value());
-    else if (arg == "--repeat") repeat = std::stoi(value());
-    else if (arg == "--threads") threads = std::stoi(value());
+    else if (arg == "--soup") soup = static_cast<std::size_t>(std::max(0.0, number()));
+    else if (arg == "--size") size = static_cast<int>(std::clamp(number(), -1.0, 1e6));
+    else if (arg == "--repeat") repeat = static_cast<int>(std::clamp(number(), -1.0, 1e6));
+    else if (arg == "--threads") threads = static_cast<int>(std::clamp(number(), -1.0, 1e4));
     else if (arg == "--timing") timing = value();
-    else if (arg == "--gap") gap_ms = std::stod(value());
+    else if (arg == "--gap") gap_ms = number();
     else throw rtcl::Error(arg + ": unknown option (--scenes-dir, --scene, --soup, --size, --repeat, --threads, --timing, --gap)");
   }
   if (size < 8 || repeat < 1 || threads < 1 || soup < 1) throw rtcl::Error("--size >= 8, --repeat, --threads, --soup >= 1");
