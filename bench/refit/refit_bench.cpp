@@ -7,8 +7,7 @@
 //   refit        Accel::refit to the moved vertices (checks, upload of the
 //                vertices and indices, the device update, the cost's
 //                read-back), alternating between two deformations so that
-//                every call moves the vertices; with Embree, each call
-//                right before one of Embree's refits below (interleaved);
+//                every call moves the vertices;
 //   Embree build rtcCommitScene of a new scene of the moved mesh at
 //                RTC_BUILD_QUALITY_MEDIUM (Embree's default binned SAH);
 //   Embree refit rtcUpdateGeometryBuffer + rtcCommitGeometry +
@@ -20,7 +19,20 @@
 //                That Embree really refits is checked in the same run: its
 //                first commit (a build) against the later ones, and a
 //                second scene whose mesh has RTC_BUILD_QUALITY_MEDIUM in
-//                the same LOW mode (a rebuild of the mesh at every commit).
+//                the same LOW mode (a rebuild of the mesh at every commit);
+//                the "Embree refits" column says yes when its refit commit
+//                takes under half of both (a rebuild would take as long).
+// The two refits are timed in one or both of two ways (--timing):
+//   interleaved  each of rtcl's refits right before one of Embree's, so
+//                that both see the same moments of a shared machine;
+//                --gap MS sleeps before each call (untimed): the threads of
+//                either library spin for a while after their work (Embree's
+//                TBB workers, rtcl's host pool), and without a gap they
+//                may take cores from the other's next call (with one, each
+//                call may wake its threads from sleep instead);
+//   blocks       all of rtcl's refits, then all of Embree's (each with its
+//                caches to itself, as an application refitting one mesh
+//                per frame has them).
 // Then the trace speed after 10 refits of a growing deformation (the sine's
 // amplitude 1% .. 10% of the size) against a fresh build over the same
 // vertices: primary rays of a camera fitted to the moved scene and their
@@ -29,7 +41,7 @@
 // threads (--threads).
 //
 //   rtcl_refit_bench [--scenes-dir DIR] [--scene bunny,dragon,soup] [--soup 1000000] [--size 512]
-//                    [--repeat 7] [--threads 2]
+//                    [--repeat 7] [--threads 2] [--timing interleaved,blocks] [--gap 0]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -40,6 +52,7 @@
 #include <utility>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "bench/support/ray_sets.hpp"
@@ -172,24 +185,46 @@ double trace_ms(const rtcl::Device& device, const rtcl::Accel& accel, const std:
 }  // namespace
 
 int main(int argc, char** argv) try {
-  std::string scenes_dir = rtcl::bench::scenes_dir(), scenes = "bunny,dragon,soup";
+  std::string scenes_dir = rtcl::bench::scenes_dir(), scenes = "bunny,dragon,soup", timing = "interleaved,blocks";
   std::size_t soup = 1000000;
   int size = 512, repeat = 7, threads = 2;
+  double gap_ms = 0.0;
   for (int i = 1; i < argc; ++i) {
     std::string arg = argv[i];
     auto value = [&]() -> std::string {
       if (i + 1 >= argc) throw rtcl::Error(arg + ": needs a value");
       return argv[++i];
     };
+    // A numeric value: the whole text a number, else an error naming the flag.
+    auto number = [&]() -> double {
+      const std::string text = value();
+      std::size_t used = 0;
+      double x = 0.0;
+      try {
+        x = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != text.size()) throw rtcl::Error(arg + " " + text + ": not a number");
+      return x;
+    };
     if (arg == "--scenes-dir") scenes_dir = value();
     else if (arg == "--scene") scenes = value();
-    else if (arg == "--soup") soup = std::stoul(value());
-    else if (arg == "--size") size = std::stoi(value());
-    else if (arg == "--repeat") repeat = std::stoi(value());
-    else if (arg == "--threads") threads = std::stoi(value());
-    else throw rtcl::Error(arg + ": unknown option (--scenes-dir, --scene, --soup, --size, --repeat, --threads)");
+    else if (arg == "--soup") soup = static_cast<std::size_t>(std::max(0.0, number()));
+    else if (arg == "--size") size = static_cast<int>(std::clamp(number(), -1.0, 1e6));
+    else if (arg == "--repeat") repeat = static_cast<int>(std::clamp(number(), -1.0, 1e6));
+    else if (arg == "--threads") threads = static_cast<int>(std::clamp(number(), -1.0, 1e4));
+    else if (arg == "--timing") timing = value();
+    else if (arg == "--gap") gap_ms = number();
+    else throw rtcl::Error(arg + ": unknown option (--scenes-dir, --scene, --soup, --size, --repeat, --threads, --timing, --gap)");
   }
   if (size < 8 || repeat < 1 || threads < 1 || soup < 1) throw rtcl::Error("--size >= 8, --repeat, --threads, --soup >= 1");
+  if (!(gap_ms >= 0.0 && gap_ms <= 1000.0)) throw rtcl::Error("--gap: milliseconds in [0, 1000]");
+  const auto gap = std::chrono::duration<double, std::milli>(gap_ms);
+  const std::vector<std::string> timings = split(timing);
+  if (timings.empty()) throw rtcl::Error("--timing: empty (interleaved, blocks or both)");
+  for (const std::string& t : timings)
+    if (t != "interleaved" && t != "blocks") throw rtcl::Error("--timing " + t + ": unknown (interleaved, blocks)");
   rtcl::Device device = rtcl::Device::open();
 #ifdef RTCL_HAVE_EMBREE
   const std::string config = "threads=" + std::to_string(threads);
@@ -219,10 +254,10 @@ int main(int argc, char** argv) try {
   }
 
   std::printf("## Refit after a smooth deformation\n\n");
-  std::printf("| scene | triangles | rebuild ms | refit ms | refit/rebuild | cost ratio | Embree build ms | "
+  std::printf("| scene | triangles | rebuild ms | Embree build ms | cost ratio | timing | refit ms | refit/rebuild | "
               "Embree refit ms | refit/Embree refit | Embree first commit ms | Embree LOW+MEDIUM commit ms | "
-              "Embree agrees |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "Embree refits | Embree agrees |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Scene& s : loaded) {
     const rtcl::Geometry& g = s.geometry;
     rtcl::Geometry moved[2] = {g, g};
@@ -234,12 +269,14 @@ int main(int argc, char** argv) try {
     const auto refit = [&](int k) {
       cost_ratio = accel->refit(moved[k % 2], {.max_cost_ratio = INFINITY}).cost_ratio();
     };
+    // Per way of timing (interleaved, blocks): rtcl's refit ms and Embree's
+    // (-1: no Embree).
+    std::vector<std::pair<double, double>> timed(timings.size(), {0.0, -1.0});
+    std::string embree_build = "-", first = "-", medium = "-", refits = "-", agrees = "-";
 #ifndef RTCL_HAVE_EMBREE
-    const double refit_ms = median_ms(repeat, refit);
-#endif
-    std::string embree_build = "-", embree_refit = "-", versus = "-", first = "-", medium = "-", agrees = "-";
-#ifdef RTCL_HAVE_EMBREE
-    char text[64];
+    for (std::size_t w = 0; w < timings.size(); ++w) timed[w].first = median_ms(repeat, refit);
+#else
+    char text[96];
     // The commit alone: the scene's setup (buffer copies) is not Embree's build.
     std::vector<double> builds;
     for (int k = 0; k <= repeat; ++k) {
@@ -252,8 +289,7 @@ int main(int argc, char** argv) try {
     // A dynamic LOW-quality scene of the mesh at `mesh_quality`: its first
     // commit (a build) into *first_ms, the median of the later ones (each
     // after moving the vertices) returned. `between(k)`, when given, runs
-    // before each commit (outside its time): our refit, timed alternately
-    // with Embree's so that both see the same moments of a shared machine.
+    // before each commit (outside its time).
     const auto timed_commits = [&](RTCBuildQuality mesh_quality, double* first_ms,
                                    const std::function<void(int)>& between) {
       auto scene = std::make_unique<EmbreeMesh>(embree, g, RTC_SCENE_FLAG_DYNAMIC, RTC_BUILD_QUALITY_LOW, mesh_quality);
@@ -272,14 +308,37 @@ int main(int argc, char** argv) try {
       return std::pair(median(ms), std::move(scene));
     };
     double first_ms = 0.0, medium_first_ms = 0.0;
-    std::vector<double> refit_runs;
-    auto [embree_refit_ms, refitted] = timed_commits(RTC_BUILD_QUALITY_REFIT, &first_ms, [&](int k) {
-      const auto start = Clock::now();
-      refit(k);
-      if (k > 0) refit_runs.push_back(ms_since(start));
-    });
-    const double refit_ms = median(refit_runs);
+    std::unique_ptr<EmbreeMesh> refitted;
+    for (std::size_t w = 0; w < timings.size(); ++w) {
+      double block_first_ms = 0.0;
+      if (timings[w] == "interleaved") {
+        std::vector<double> refit_runs;
+        auto [embree_ms, scene] = timed_commits(RTC_BUILD_QUALITY_REFIT, &block_first_ms, [&](int k) {
+          std::this_thread::sleep_for(gap);
+          const auto start = Clock::now();
+          refit(k);
+          if (k > 0) refit_runs.push_back(ms_since(start));
+          std::this_thread::sleep_for(gap);
+        });
+        timed[w] = {median(refit_runs), embree_ms};
+        refitted = std::move(scene);
+      } else {
+        const double ours = median_ms(repeat, refit);
+        auto [embree_ms, scene] = timed_commits(RTC_BUILD_QUALITY_REFIT, &block_first_ms, {});
+        timed[w] = {ours, embree_ms};
+        refitted = std::move(scene);
+      }
+      if (w == 0) first_ms = block_first_ms;
+    }
     const double medium_ms = timed_commits(RTC_BUILD_QUALITY_MEDIUM, &medium_first_ms, {}).first;
+    // Embree refits when its refit commits take under half of a build (its
+    // first commit) and of a rebuild of the mesh (a MEDIUM-quality mesh in
+    // the same LOW-quality dynamic scene): a rebuild would take as long.
+    double slowest = 0.0;
+    for (const auto& [ours, theirs] : timed) slowest = std::max(slowest, theirs);
+    const double share = slowest / std::min(first_ms, medium_ms);
+    std::snprintf(text, sizeof text, "%s (%.2fx a rebuild)", share < 0.5 ? "yes" : "NO", share);
+    refits = text;
     // Embree's refitted scene answers for the last vertices it was given
     // (moved[repeat % 2]) as our refitted structure does for its last ones.
     accel->refit(moved[repeat % 2]);
@@ -291,10 +350,6 @@ int main(int argc, char** argv) try {
     for (std::size_t i = 0; i < rays.size(); ++i) same += ours[i].prim == theirs[i];
     std::snprintf(text, sizeof text, "%.2f", embree_build_ms);
     embree_build = text;
-    std::snprintf(text, sizeof text, "%.2f", embree_refit_ms);
-    embree_refit = text;
-    std::snprintf(text, sizeof text, "%.2f", refit_ms / embree_refit_ms);
-    versus = text;
     std::snprintf(text, sizeof text, "%.2f", first_ms);
     first = text;
     std::snprintf(text, sizeof text, "%.2f", medium_ms);
@@ -302,9 +357,18 @@ int main(int argc, char** argv) try {
     std::snprintf(text, sizeof text, "%.2f%%", 100.0 * static_cast<double>(same) / static_cast<double>(rays.size()));
     agrees = text;
 #endif
-    std::printf("| %s | %zu | %.2f | %.2f | %.3f | %.3f | %s | %s | %s | %s | %s | %s |\n", s.name.c_str(),
-                g.triangles.size(), rebuild_ms, refit_ms, refit_ms / rebuild_ms, cost_ratio, embree_build.c_str(),
-                embree_refit.c_str(), versus.c_str(), first.c_str(), medium.c_str(), agrees.c_str());
+    for (std::size_t w = 0; w < timings.size(); ++w) {
+      const auto [refit_ms, embree_refit_ms] = timed[w];
+      char theirs[32] = "-", versus[32] = "-";
+      if (embree_refit_ms >= 0.0) {
+        std::snprintf(theirs, sizeof theirs, "%.2f", embree_refit_ms);
+        std::snprintf(versus, sizeof versus, "%.2f", refit_ms / embree_refit_ms);
+      }
+      std::printf("| %s | %zu | %.2f | %s | %.3f | %s | %.2f | %.3f | %s | %s | %s | %s | %s | %s |\n", s.name.c_str(),
+                  g.triangles.size(), rebuild_ms, embree_build.c_str(), cost_ratio, timings[w].c_str(), refit_ms,
+                  refit_ms / rebuild_ms, theirs, versus, first.c_str(), medium.c_str(), refits.c_str(),
+                  agrees.c_str());
+    }
     std::fflush(stdout);
   }
 

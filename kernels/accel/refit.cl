@@ -9,19 +9,24 @@
  * the triangles' indices when they are new; then each refit reads the
  * corners' indices in block order, not through the triangles.
  *
- * refit_bottom_up, one work-item per triangle block, then one per start
- * node (a node none of whose lanes is a triangle block or an inner node:
- * only sphere blocks, which keep their build's boxes): a block's
- * work-item fills its lanes from the vertices, takes the box of their
- * corners and writes it into its lane of the parent node. Each node counts
- * the lanes written into it (counters[n], atomically); the work-item whose
- * write completes the count (arrivals[n]) goes on with that node: it reads
- * the node's eight lanes, writes the node's share of the SAH cost, writes
- * the node's box into its own lane of its parent, and so up, until the
- * root. Every node is thus finished once, after all of its children, by
- * one work-item, in one launch; the finishing work-item sets the counter
- * back to 0 for the next refit. up[n] (up_blocks[b]) is the parent's index
- * times 8 plus the lane (the root's is RTCL_REFIT_ROOT).
+ * refit_bottom_up, one work-item per block node (a node with at least one
+ * triangle block among its lanes), then one per start node (a node none of
+ * whose lanes is a triangle block or an inner node: only sphere blocks,
+ * which keep their build's boxes): a block node's work-item fills its
+ * blocks' lanes from the vertices and writes each block's box (that of its
+ * corners) into the block's lane of the node. Each node counts the lanes
+ * written into it (counters[n], atomically; a work-item that wrote all of
+ * a node's lanes itself skips the count); the work-item whose count
+ * completes arrivals[n] (the node's triangle-block and inner-node lanes)
+ * goes on with that node: it reads the node's eight lanes, writes the
+ * node's share of the SAH cost, writes the node's box into its own lane
+ * of its parent, and so up, until the root. Every node is thus finished
+ * once, after all of its children, by one work-item, in one launch; the
+ * finishing work-item sets the counter back to 0 for the next refit. A
+ * work-item per block node rather than per block: the count's atomic (a
+ * full barrier on a CPU, waiting for the block's stores) is paid per node,
+ * and a node's blocks are filled by one core. up[n] is node n's parent's
+ * index times 8 plus its lane (the root's is RTCL_REFIT_ROOT).
  *
  * Memory: the lane writes come before a global fence and the counter's
  * atomic increment; the finishing work-item fences after its increment and
@@ -60,6 +65,12 @@ float box_area(float3 lo, float3 hi) {
   return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
+/* Componentwise minimum and maximum of finite values (refit.cpp refuses
+ * vertices that are not finite): plain compares, which a CPU compiler turns
+ * into one instruction each, where fmin and fmax also order NaNs. */
+float3 min3(float3 a, float3 b) { return select(b, a, a < b); }
+float3 max3(float3 a, float3 b) { return select(b, a, a > b); }
+
 /* Block b's lanes from the vertices; returns their box in *lo, *hi. */
 void fill_block(global TriangleBlock* block, global const uint* corners, global const float* vertices, float3* lo,
                 float3* hi) {
@@ -78,8 +89,8 @@ void fill_block(global TriangleBlock* block, global const uint* corners, global 
     block->v[2][0][lane] = c.x;
     block->v[2][1][lane] = c.y;
     block->v[2][2][lane] = c.z;
-    l = fmin(l, fmin(a, fmin(b, c)));
-    h = fmax(h, fmax(a, fmax(b, c)));
+    l = min3(l, min3(a, min3(b, c)));
+    h = max3(h, max3(a, max3(b, c)));
   }
   *lo = l;
   *hi = h;
@@ -111,42 +122,48 @@ void finish_node(global Bvh8Node* nodes, uint n, float node_cost, global float* 
     const float3 b = (float3)(bounds[3 * RTCL_BLOCK_WIDTH + lane], bounds[4 * RTCL_BLOCK_WIDTH + lane],
                               bounds[5 * RTCL_BLOCK_WIDTH + lane]);
     cost += (c >= 0 ? node_cost : 1.0f) * box_area(a, b);
-    l = fmin(l, a);
-    h = fmax(h, b);
+    l = min3(l, a);
+    h = max3(h, b);
   }
   cost_parts[n] = cost;
   *lo = l;
   *hi = h;
 }
 
-/* After writing its lane of node n: whether this work-item's write is the
- * last of node n's arrivals[n] (then it finishes n, and the counter is
- * back at 0 for the next refit). The fences order the lane writes before
- * the count and the count before the reads of n's lanes. */
-inline bool last_to_arrive(global uint* counters, global const uint* arrivals, uint n) {
+/* After writing `count` lanes of node n: whether these writes are the last
+ * of node n's arrivals[n] (then this work-item finishes n, and the counter
+ * is back at 0 for the next refit). The fences order the lane writes
+ * before the count and the count before the reads of n's lanes. */
+inline bool last_to_arrive(global uint* counters, global const uint* arrivals, uint n, uint count) {
   mem_fence(CLK_GLOBAL_MEM_FENCE);
-  if (atomic_inc(counters + n) + 1 != arrivals[n]) return false;
+  if (atomic_add(counters + n, count) + count != arrivals[n]) return false;
   counters[n] = 0;
   mem_fence(CLK_GLOBAL_MEM_FENCE);
   return true;
 }
 
-kernel void refit_bottom_up(global TriangleBlock* blocks, uint block_count, global const uint* lane_vertices,
-                            global const float* vertices, global Bvh8Node* nodes, global const uint* up_blocks,
-                            global const uint* up, global const uint* arrivals, global uint* counters,
-                            global const uint* start_nodes, uint start_count, float node_cost,
-                            global float* cost_parts) {
+kernel void refit_bottom_up(global TriangleBlock* blocks, global const uint* lane_vertices,
+                            global const float* vertices, global Bvh8Node* nodes, global const uint* up,
+                            global const uint* arrivals, global uint* counters, global const uint* block_nodes,
+                            uint block_node_count, global const uint* start_nodes, uint start_count,
+                            float node_cost, global float* cost_parts) {
   const uint i = get_global_id(0);
   float3 lo, hi;
   uint n;  /* the node to finish next */
-  if (i < block_count) {
-    fill_block(blocks + i, lane_vertices + 3 * RTCL_BLOCK_WIDTH * i, vertices, &lo, &hi);
-    const uint to = up_blocks[i];
-    write_lane(nodes, to, lo, hi);
-    n = to / RTCL_BLOCK_WIDTH;
-    if (!last_to_arrive(counters, arrivals, n)) return;
-  } else if (i < block_count + start_count) {
-    n = start_nodes[i - block_count];
+  if (i < block_node_count) {
+    n = block_nodes[i];
+    uint filled = 0;
+    for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
+      const int c = nodes[n].child[lane];
+      if (c >= 0 || c == RTCL_CHILD_EMPTY || (~c & 1) != 0) continue;  /* inner node, empty, sphere block */
+      const uint b = (uint)(~c) >> 1;
+      fill_block(blocks + b, lane_vertices + 3 * RTCL_BLOCK_WIDTH * b, vertices, &lo, &hi);
+      write_lane(nodes, n * RTCL_BLOCK_WIDTH + lane, lo, hi);
+      ++filled;
+    }
+    if (filled != arrivals[n] && !last_to_arrive(counters, arrivals, n, filled)) return;
+  } else if (i < block_node_count + start_count) {
+    n = start_nodes[i - block_node_count];
   } else {
     return;
   }
@@ -156,6 +173,6 @@ kernel void refit_bottom_up(global TriangleBlock* blocks, uint block_count, glob
     if (to == RTCL_REFIT_ROOT) return;
     write_lane(nodes, to, lo, hi);
     n = to / RTCL_BLOCK_WIDTH;
-    if (!last_to_arrive(counters, arrivals, n)) return;
+    if (!last_to_arrive(counters, arrivals, n, 1)) return;
   }
 }

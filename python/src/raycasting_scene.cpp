@@ -143,7 +143,12 @@ void write_flat(const FlatScene& flat, bool one_part, const Hit* __restrict hits
   float* __restrict uv = out.uv + 2 * first;
   float* __restrict nrm = out.normal + 3 * first;
   const glm::vec3* __restrict normals = flat.normals.data();
+  // The normals' table is read in the hits' order, which jumps: each
+  // hit's normal is fetched kAhead hits before it is written.
+  constexpr std::size_t kAhead = 16;
   for (std::size_t k = 0; k < n; ++k) {
+    if (k + kAhead < n && hits[k + kAhead].prim >= 0)
+      __builtin_prefetch(normals + hits[k + kAhead].prim);
     const Hit h = hits[k];
     if (id) id[k] = kInvalidId;
     if (h.prim < 0) {

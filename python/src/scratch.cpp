@@ -111,9 +111,18 @@ void pipeline(std::size_t count, const std::function<void(int, std::size_t, std:
               const std::function<void(int, std::size_t, std::size_t)>& run,
               const std::function<void(int, std::size_t, std::size_t, bool)>& unpack) {
   if (count == 0) return;
-  const std::size_t chunks = (count + kChunk - 1) / kChunk;
-  auto first = [](std::size_t k) { return k * kChunk; };
-  auto size = [&](std::size_t k) { return std::min(kChunk, count - k * kChunk); };
+  // Chunk k is [bounds[k], bounds[k + 1]): one chunk up to kChunk, else a
+  // first and a last chunk of kEdgeChunk with chunks of kChunk between.
+  std::vector<std::size_t> bounds{0};
+  if (count > kChunk) {
+    bounds.push_back(kEdgeChunk);
+    for (std::size_t at = kEdgeChunk + kChunk; at < count - kEdgeChunk; at += kChunk) bounds.push_back(at);
+    bounds.push_back(count - kEdgeChunk);
+  }
+  bounds.push_back(count);
+  const std::size_t chunks = bounds.size() - 1;
+  auto first = [&](std::size_t k) { return bounds[k]; };
+  auto size = [&](std::size_t k) { return bounds[k + 1] - bounds[k]; };
   pack(0, 0, size(0), true);
   if (chunks == 1) {
     run(0, 0, size(0));

@@ -20,9 +20,13 @@
 namespace rtcl::python {
 
 // Rays or points per library call when a call is split: enough that a
-// call's fixed costs stay small, few enough that the conversions of the
-// first and last chunk, which nothing overlaps, are short.
+// call's fixed costs stay small, few enough that a leased set stays small.
 inline constexpr std::size_t kChunk = std::size_t{1} << 18;
+// The first and the last chunk of a split call: their conversions overlap
+// nothing, so they are kept short enough to run on the calling thread alone
+// (below for_parts' share per thread: no pooled thread is woken, which
+// would then spin for its next job on a core the device's threads use).
+inline constexpr std::size_t kEdgeChunk = std::size_t{1} << 14;
 
 // Not zeroed when grown, and advised for huge pages (rtcl/huge_pages.hpp).
 template <class T>
@@ -58,7 +62,8 @@ class ScratchLease {
   std::unique_ptr<Scratch> scratch_;
 };
 
-// Runs [0, count) chunk by chunk ([first, first + n), n <= kChunk) through
+// Runs [0, count) chunk by chunk ([first, first + n): all of it up to
+// kChunk, else kEdgeChunk, then kChunk each, then kEdgeChunk) through
 // pack(slot, first, n, parallel), run(slot, first, n) and
 // unpack(slot, first, n, parallel), where slot (0 or 1) names one of two
 // sets of scratch arrays. run(k) on the calling thread (the device work)

@@ -23,6 +23,11 @@ using Clock = std::chrono::steady_clock;
 constexpr std::uint32_t kRefitRoot = 0xffffffffu;
 // Vertices or triangles per host thread in the checks (parallel.hpp).
 constexpr std::size_t kCheckPartMin = 65536;
+// Floats and triangle indices per host thread in a refit's scan: a pooled
+// thread spins for its next job after its part (thread_pool.hpp), on a CPU
+// device on a core that the refit's kernel then wants, so the scan takes a
+// second thread only where that saves more than its spin costs.
+constexpr std::size_t kScanPartMin = std::size_t{1} << 22;
 
 double elapsed_ms(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -166,38 +171,47 @@ Bvh8Refit::Bvh8Refit(const Bvh8& bvh, const Geometry& geometry)
       lane_count_(bvh.blocks.triangles.size() * RTCL_BLOCK_WIDTH),
       spheres_(geometry.spheres),
       zero_area_(bvh.zero_area_triangles) {
-  // Every node's and triangle block's place in its parent (parent * 8 +
-  // lane), the lanes each node waits for (inner nodes and triangle
-  // blocks), and the nodes that wait for none. Each must be reached once
-  // (the flatten checked the tree; a broken one is an internal error).
+  // Every node's place in its parent (parent * 8 + lane), the lanes each
+  // node waits for (inner nodes and triangle blocks), the nodes with
+  // triangle blocks and the nodes that wait for none. Each node and block
+  // must be reached once (the flatten checked the tree; a broken one is an
+  // internal error).
   const std::size_t blocks = bvh.blocks.triangles.size();
   if (node_count_ >= (std::size_t{1} << 29) || blocks >= (std::size_t{1} << 32))
     throw Error("refit: the tree has more nodes or blocks than its refit indexes (2^29 nodes)");
   up_.assign(node_count_, kRefitRoot);
-  up_blocks_.assign(blocks, kRefitRoot);
   arrivals_.assign(node_count_, 0);
-  std::size_t reached = 1;
-  for (std::size_t n = 0; n < node_count_; ++n)
+  std::vector<bool> block_reached(blocks, false);
+  std::size_t reached = 1, blocks_reached = 0;
+  for (std::size_t n = 0; n < node_count_; ++n) {
+    bool has_blocks = false;
     for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
       const rtcl_i32 c = bvh.nodes[n].child[lane];
       const auto place = static_cast<std::uint32_t>(n * RTCL_BLOCK_WIDTH + static_cast<std::size_t>(lane));
-      std::uint32_t* slot = nullptr;
+      bool fresh = false;
       if (c >= 0 && static_cast<std::size_t>(c) < node_count_ && c != 0) {
-        slot = &up_[static_cast<std::size_t>(c)];
+        std::uint32_t& slot = up_[static_cast<std::size_t>(c)];
+        fresh = slot == kRefitRoot;
+        slot = place;
         ++reached;
       } else if (c < 0 && c != RTCL_CHILD_EMPTY && (~c & 1) == 0 &&
                  (static_cast<std::uint32_t>(~c) >> 1) < blocks) {
-        slot = &up_blocks_[static_cast<std::uint32_t>(~c) >> 1];
+        const std::size_t b = static_cast<std::uint32_t>(~c) >> 1;
+        fresh = !block_reached[b];
+        block_reached[b] = true;
+        ++blocks_reached;
+        has_blocks = true;
       } else if (c == RTCL_CHILD_EMPTY || (c < 0 && (~c & 1) == 1)) {
         continue;  // empty, or a sphere block: as built
       }
-      if (!slot || *slot != kRefitRoot)
+      if (!fresh)
         throw Error("internal: refit: node " + std::to_string(n) + " lane " + std::to_string(lane) +
                     " refers to a child that does not exist or has another parent");
-      *slot = place;
       ++arrivals_[n];
     }
-  if (reached != node_count_ || std::find(up_blocks_.begin(), up_blocks_.end(), kRefitRoot) != up_blocks_.end())
+    if (has_blocks) block_nodes_.push_back(static_cast<std::uint32_t>(n));
+  }
+  if (reached != node_count_ || blocks_reached != blocks)
     throw Error("internal: refit: the tree does not reach every node and block");
   for (std::size_t n = 0; n < node_count_; ++n)
     if (arrivals_[n] == 0) start_nodes_.push_back(static_cast<std::uint32_t>(n));
@@ -210,7 +224,7 @@ Bvh8Refit::~Bvh8Refit() = default;
 // ---- The device side ---------------------------------------------------------
 
 struct Bvh8Refit::DeviceState {
-  cl::Buffer vertices, lane_vertices, up, up_blocks, arrivals, counters, start_nodes, cost_parts;
+  cl::Buffer vertices, lane_vertices, up, arrivals, counters, block_nodes, start_nodes, cost_parts;
   cl::Kernel lane_table, bottom_up;
   std::vector<float> cost_parts_host;
   // The counters are all 0 (a refit that failed on the device may leave
@@ -238,15 +252,14 @@ Bvh8Refit::DeviceState& Bvh8Refit::device_state(const Device& device) {
                      : device.upload(v.data(), v.size() * sizeof(std::uint32_t), what);
   };
   st->up = upload(up_, "refit parents of nodes");
-  st->up_blocks = upload(up_blocks_, "refit parents of blocks");
   st->arrivals = upload(arrivals_, "refit lanes per node");
+  st->block_nodes = upload(block_nodes_, "refit block nodes");
   st->start_nodes = upload(start_nodes_, "refit start nodes");
   st->counters = upload(std::vector<std::uint32_t>(node_count_, 0), "refit counters");
   st->cost_parts = device.allocate(node_count_ * sizeof(float), "refit costs");
   st->cost_parts_host.resize(node_count_);
   device_ = std::move(st);
   up_ = {};  // on the device now
-  up_blocks_ = {};
   arrivals_ = {};
   return *device_;
 }
@@ -271,34 +284,38 @@ void Bvh8Refit::check(const std::string& name, const Geometry& geometry) const {
       throw Error(at + "spheres[" + std::to_string(i) +
                   "] differs from the build's (a refit moves triangles only; build anew to move spheres)");
   }
-  // A pass that the compiler vectorises (a float is NaN or infinite when
-  // its exponent bits are all ones), then the first bad vertex's index.
-  const auto infinite = [](float f) { return (std::bit_cast<std::uint32_t>(f) & 0x7f800000u) == 0x7f800000u; };
-  const std::size_t vertices = geometry.vertices.size();
-  for_each_part(vertices, part_count(vertices, 0, kCheckPartMin), [&](unsigned, std::size_t begin, std::size_t end) {
-    bool bad = false;
-    for (std::size_t i = begin; i < end; ++i) {
-      const glm::vec3& v = geometry.vertices[i];
-      bad |= infinite(v.x) | infinite(v.y) | infinite(v.z);
-    }
-    if (!bad) return;
-    for (std::size_t i = begin; i < end; ++i) {
-      const glm::vec3& v = geometry.vertices[i];
-      if (infinite(v.x) || infinite(v.y) || infinite(v.z))
-        throw Error(at + "vertices[" + std::to_string(i) + "] is not finite");
-    }
-  });
 }
 
-bool Bvh8Refit::same_triangles(const Geometry& geometry) const {
+bool Bvh8Refit::scan(const std::string& name, const Geometry& geometry) const {
+  // Each part checks its share of the vertices and compares its share of
+  // the triangles with the lane table's; the first bad vertex is found
+  // again after the pass. A float is NaN or infinite when its exponent bits
+  // are all ones, which is when adding one to the exponent carries into the
+  // sign bit: an OR over those sums, which the compiler vectorises.
   const std::vector<glm::uvec3>& known = device_->triangles;
-  if (known.size() != geometry.triangles.size() || known.empty()) return false;
-  std::atomic<bool> same{true};
-  const std::size_t n = known.size();
-  for_each_part(n, part_count(n, 0, kCheckPartMin), [&](unsigned, std::size_t begin, std::size_t end) {
-    if (std::memcmp(known.data() + begin, geometry.triangles.data() + begin, (end - begin) * sizeof(glm::uvec3)))
+  const bool compare = known.size() == geometry.triangles.size() && !known.empty();
+  const std::size_t values = 3 * geometry.vertices.size(), triangles = compare ? known.size() : 0;
+  const float* floats = values ? &geometry.vertices[0].x : nullptr;
+  constexpr std::uint32_t kExponent = 0x7f800000u, kExponentOne = 0x00800000u, kSign = 0x80000000u;
+  std::atomic<bool> finite{true}, same{compare};
+  const unsigned parts = part_count(values + 3 * triangles, 0, kScanPartMin);
+  for_each_part(parts, parts, [&](unsigned part, std::size_t, std::size_t) {
+    std::uint32_t carries = 0;
+    for (std::size_t i = values * part / parts, end = values * (part + 1) / parts; i < end; ++i)
+      carries |= (std::bit_cast<std::uint32_t>(floats[i]) & kExponent) + kExponentOne;
+    if (carries & kSign) finite.store(false, std::memory_order_relaxed);
+    const std::size_t begin = triangles * part / parts, end = triangles * (part + 1) / parts;
+    if (end > begin &&
+        std::memcmp(known.data() + begin, geometry.triangles.data() + begin, (end - begin) * sizeof(glm::uvec3)))
       same.store(false, std::memory_order_relaxed);
   });
+  if (!finite.load())
+    for (std::size_t i = 0; i < geometry.vertices.size(); ++i) {
+      const glm::vec3& v = geometry.vertices[i];
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        throw Error(name + " refit of \"" + geometry.source + "\": geometry.vertices[" + std::to_string(i) +
+                    "] is not finite");
+    }
   return same.load();
 }
 
@@ -322,7 +339,8 @@ RefitStats Bvh8Refit::run(const Accel& accel, const cl::Buffer& nodes, const cl:
   const Device& device = accel.device();
   DeviceState& st = device_state(device);  // allocations first: nothing changed yet when they fail
   // New triangles (or the first refit): their lane table is made again.
-  const bool new_triangles = lane_count_ > 0 && !same_triangles(geometry);
+  const bool same = scan(accel.name(), geometry);
+  const bool new_triangles = lane_count_ > 0 && !same;
   if (new_triangles || lane_count_ == 0) check_indices(accel.name(), geometry);
   RefitStats stats;
   stats.build_cost = build_cost_;
@@ -371,24 +389,24 @@ RefitStats Bvh8Refit::run(const Accel& accel, const cl::Buffer& nodes, const cl:
         queue.enqueueFillBuffer(st.counters, cl_uint{0}, 0, node_count_ * sizeof(cl_uint), &last, &cleared);
         last = {cleared};
       }
-      const auto blocks = static_cast<cl_uint>(lane_count_ / RTCL_BLOCK_WIDTH);
+      const auto block_nodes = static_cast<cl_uint>(block_nodes_.size());
       const auto starts = static_cast<cl_uint>(start_nodes_.size());
       cl_uint a = 0;
       st.bottom_up.setArg(a++, triangle_blocks);
-      st.bottom_up.setArg(a++, blocks);
       st.bottom_up.setArg(a++, st.lane_vertices);
       st.bottom_up.setArg(a++, st.vertices);
       st.bottom_up.setArg(a++, nodes);
-      st.bottom_up.setArg(a++, st.up_blocks);
       st.bottom_up.setArg(a++, st.up);
       st.bottom_up.setArg(a++, st.arrivals);
       st.bottom_up.setArg(a++, st.counters);
+      st.bottom_up.setArg(a++, st.block_nodes);
+      st.bottom_up.setArg(a++, block_nodes);
       st.bottom_up.setArg(a++, st.start_nodes);
       st.bottom_up.setArg(a++, starts);
       st.bottom_up.setArg(a++, kRefitNodeCost);
       st.bottom_up.setArg(a++, st.cost_parts);
       st.counters_clear = false;  // until the launch is known to have finished
-      last = {detail::AccelAccess::launch(accel, st.bottom_up, std::size_t{blocks} + starts, last)};
+      last = {detail::AccelAccess::launch(accel, st.bottom_up, std::size_t{block_nodes} + starts, last)};
       cl::Event costs_read, root_read;
       queue.enqueueReadBuffer(st.cost_parts, CL_FALSE, 0, node_count_ * sizeof(float), st.cost_parts_host.data(),
                               &last, &costs_read);

@@ -11,10 +11,10 @@
 // table of each block lane's corner indices that it makes from the
 // triangles once (kept while the triangles stay the same: the host keeps a
 // copy to compare). One launch does the rest (refit.cl, refit_bottom_up):
-// one work-item per triangle block fills its lanes and carries the block's
-// box up the tree, the last child to arrive at a node finishing it, so
-// that a small mesh pays one launch, not one per level of the tree; on a
-// CPU device it runs on the same cores a host pool would, with every
+// one work-item per node with triangle blocks fills their lanes and carries
+// the node's box up the tree, the last child to arrive at a node finishing
+// it, so that a small mesh pays one launch, not one per level of the tree;
+// on a CPU device it runs on the same cores a host pool would, with every
 // block's loads independent of the others'.
 #pragma once
 
@@ -70,10 +70,12 @@ class Bvh8Refit {
 
  private:
   struct DeviceState;
-  // Throws Error for a count, sphere or vertex that a refit cannot take.
+  // Throws Error for a count or sphere that a refit cannot take.
   void check(const std::string& name, const Geometry& geometry) const;
-  // Whether geometry's triangles are those the lane table was made from.
-  bool same_triangles(const Geometry& geometry) const;
+  // One pass over geometry (after device_state): throws Error for a vertex
+  // that is not finite; returns whether geometry's triangles are those the
+  // lane table was made from.
+  bool scan(const std::string& name, const Geometry& geometry) const;
   // Throws Error for an index beyond the vertices.
   void check_indices(const std::string& name, const Geometry& geometry) const;
   DeviceState& device_state(const Device& device);
@@ -83,10 +85,10 @@ class Bvh8Refit {
   std::vector<Sphere> spheres_;                 // as built: a refit moves triangles only
   std::vector<std::uint32_t> zero_area_;        // triangles skipped at the build
   // The tree's shape for refit.cl's refit_bottom_up (moved to the device
-  // at the first refit): each node's and triangle block's parent * 8 +
-  // lane (the root's 0xffffffff), the lanes each node waits for, and the
-  // nodes that wait for none.
-  std::vector<std::uint32_t> up_, up_blocks_, arrivals_, start_nodes_;
+  // at the first refit): each node's parent * 8 + lane (the root's
+  // 0xffffffff), the lanes each node waits for, the nodes with triangle
+  // blocks among their lanes, and the nodes that wait for none.
+  std::vector<std::uint32_t> up_, arrivals_, block_nodes_, start_nodes_;
   double build_cost_ = 0.0, cost_ = 0.0;        // cost_: the tree's now
   std::unique_ptr<DeviceState> device_;
 };
