@@ -384,6 +384,82 @@ TEST(TwoLevel, OneTransformedInstanceAnswersAsItsCopy) {
   }
 }
 
+// An identity instance (its bottom level walked with the world ray), ones
+// that only translate (the world ray's origin minus the translation, the
+// direction's setup kept) and mirrored ones with the same kind of
+// translations (their linear part is not the identity: the whole object
+// ray): a cube with dyadic vertices at dyadic translations, axis-parallel
+// rays through its vertices, edges and face planes with both signs of each
+// zero component. Every map is exact, so at robust and exact each closest
+// t equals brute force's on the pre-transformed copy bit for bit, and
+// each query hits only where brute force does; every answer passes the
+// double-precision judge.
+TEST(TwoLevel, IdentityTranslatedAndMirroredInstancesAnswerAxisRaysExactly) {
+  const Geometry cube = cube_grid(4);
+  const std::vector<Transform> transforms = {
+      Transform::identity(),
+      Transform::translate(8, 0, 0),
+      Transform::translate(0, -8, 0.5f),
+      Transform::translate(0, 8, 0) * Transform::scale(-1, 1, 1),
+      Transform::translate(-8, 0, 0) * Transform::scale(1, -1, 1),
+      Transform::translate(0, 0, 8) * Transform::scale(-1, -1, -1),
+  };
+  std::vector<Ray> rays;
+  for (const Transform& t : transforms)
+    for (int axis = 0; axis < 3; ++axis)
+      for (double sign : {1.0, -1.0})
+        for (int j = 0; j <= 8; ++j)
+          for (int k = 0; k <= 8; ++k)
+            for (int zeros = 0; zeros < 4; ++zeros) {
+              glm::dvec3 o(0.0), d(0.0);
+              o[axis] = -3.0 * sign;
+              o[(axis + 1) % 3] = -1.0 + 0.25 * j;
+              o[(axis + 2) % 3] = -1.0 + 0.25 * k;
+              d[axis] = sign;
+              glm::vec3 world_d(linear_part(t) * d);
+              world_d[(axis + 1) % 3] = (zeros & 1) ? -0.0f : 0.0f;
+              world_d[(axis + 2) % 3] = (zeros & 2) ? -0.0f : 0.0f;
+              rays.push_back(make_ray(glm::vec3(apply(t, o)), world_d, 0.0f, 5.0f));
+            }
+  const FlatInstances flat = flatten_instances(cube, transforms);
+  for (Precision level : test_precisions()) {
+    AccelConfig config;
+    config.precision = level;
+    auto brute = make_accel(test_device(), "brute", flat.geometry, config);
+    Scene scene(test_device(), {level});
+    const MeshId id = scene.add_mesh(cube);
+    for (const Transform& t : transforms) scene.add_instance(id, t);
+    scene.commit();
+    for (Query query : {Query::closest, Query::any}) {
+      std::vector<Hit> hits(rays.size());
+      std::vector<std::uint32_t> ids(rays.size());
+      scene.trace(query, rays, hits, ids);
+      const std::vector<Hit> expected = run_query(*brute, rays, query);
+      std::vector<Hit> mapped(rays.size());
+      std::size_t hit_count = 0;
+      for (std::size_t i = 0; i < rays.size(); ++i) {
+        mapped[i] = hits[i].prim >= 0 ? flat_hit(flat, ids[i], hits[i]) : hits[i];
+        hit_count += hits[i].prim >= 0;
+      }
+      const std::string what = std::string(precision_name(level)) + (query == Query::closest ? " closest" : " any");
+      expect_at_level(level, false, what, [&] {
+        std::size_t differing = 0, failures = 0;
+        std::string first;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+          const bool same = (mapped[i].prim < 0) == (expected[i].prim < 0) &&
+                            (query == Query::any || mapped[i].prim < 0 || mapped[i].t == expected[i].t);
+          if (!same && differing++ == 0)
+            first = "ray " + describe(rays[i]) + ": " + describe(mapped[i]) + ", brute force " + describe(expected[i]);
+        }
+        std::vector<std::string> judged = judge_all(flat.geometry, rays, mapped, query, &failures, 3);
+        EXPECT_EQ(differing, 0u) << what << ", " << rays.size() << " rays; first: " << first;
+        EXPECT_EQ(failures, 0u) << what << ": " << (judged.empty() ? "" : judged.front());
+      });
+      EXPECT_GT(hit_count, rays.size() / 2) << what;
+    }
+  }
+}
+
 // The top level over instance boxes: every instance in exactly one leaf
 // slot, every slot's box containing the boxes below it.
 TEST(TwoLevel, TopLevelHoldsEveryInstanceOnce) {

@@ -95,37 +95,35 @@ inline Ray instance_object_ray(const TraceRay* s, global const InstanceRecord* i
       global const SphereBlock *spheres
 #define INSTANCES_ARGS top, instances, motions, bottoms, nodes, triangles, spheres
 
-inline float rtcl_axis_of(float x, float y, float z, int axis) { return axis == 0 ? x : axis == 1 ? y : z; }
-
-/* Instance k against the ray: its bottom level walked with the object ray.
- * Records a nearer hit in h and k in *hit_instance; returns whether it
- * recorded one (any hit: whether the instance blocks the ray).
- *
- * The object ray is set up in s itself and s is restored after the walk:
- * on PoCL a walk with a copy of the ray record is markedly slower than with
- * the kernel's own record (docs/benchmarks.md).
- * An instance that only translates (RTCL_INSTANCE_LINEAR_IDENTITY) changes
- * the origin alone (the direction's setup stays the world ray's, bit for
- * bit what trace_ray_setup gives for it); any other has the whole setup
- * (trace_ray_setup) of its object ray. */
-inline int instance_visit(uint k, TraceRay* s, HitState* h, float tau, uint* hit_instance, INSTANCES_PARAMS) {
-  global const InstanceRecord* in = instances + k;
-  BottomLevel b = bottoms[in->bottom];
-  float t_before = h->t_best;
-  int prim_before = h->prim;
-#ifdef RTCL_PRECISION_EXACT
-  double exact_before = h->t_exact;
-#endif
+/* The walk of the bottom level (nodes, triangles, spheres) of
+ * instance `in`, whose transform is not the identity, with its object ray
+ * set up in s itself; s is restored after the walk (on PoCL a walk with a
+ * copy of the ray record is markedly slower than with the kernel's own
+ * record: docs/benchmarks.md). An instance that only translates
+ * (RTCL_INSTANCE_LINEAR_IDENTITY) changes the origin alone (the
+ * direction's setup stays the world ray's, bit for bit what
+ * trace_ray_setup gives for it); any other has the whole setup
+ * (trace_ray_setup) of its object ray. Out of line: its code beside the
+ * identity instance's call cost that call some 4% (bench/scenes/
+ * instances_bench.cpp). Returns bvh_traverse's answer. */
+__attribute__((noinline)) int instance_walk_transformed(TraceRay* s, HitState* h,
+                                                         global const InstanceRecord* in,
+                                                         global const InstanceMotion* motions, float tau,
+                                                         global const Bvh8Node* nodes,
+                                                         global const TriangleBlock* triangles,
+                                                         global const SphereBlock* spheres) {
   int leaf;
   if ((in->flags & (RTCL_INSTANCE_LINEAR_IDENTITY | RTCL_INSTANCE_MOVING)) == RTCL_INSTANCE_LINEAR_IDENTITY) {
     float ox = s->ox, oy = s->oy, oz = s->oz, okx = s->okx, oky = s->oky, okz = s->okz;
-    s->ox = ox - in->translation[0];
-    s->oy = oy - in->translation[1];
-    s->oz = oz - in->translation[2];
-    s->okx = rtcl_axis_of(s->ox, s->oy, s->oz, s->kx);
-    s->oky = rtcl_axis_of(s->ox, s->oy, s->oz, s->ky);
-    s->okz = rtcl_axis_of(s->ox, s->oy, s->oz, s->kz);
-    leaf = bvh_traverse(s, h, nodes + b.node_offset, triangles + b.triangle_offset, spheres + b.sphere_offset);
+    global const float* t = in->translation;
+    s->ox = ox - t[0];
+    s->oy = oy - t[1];
+    s->oz = oz - t[2];
+    /* the permuted origin's components are the same differences */
+    s->okx = okx - t[s->kx];
+    s->oky = oky - t[s->ky];
+    s->okz = okz - t[s->kz];
+    leaf = bvh_traverse(s, h, nodes, triangles, spheres);
     s->ox = ox;
     s->oy = oy;
     s->oz = oz;
@@ -135,10 +133,34 @@ inline int instance_visit(uint k, TraceRay* s, HitState* h, float tau, uint* hit
   } else {
     TraceRay world = *s;
     leaf = trace_ray_setup(instance_object_ray(&world, in, motions, tau), s)
-               ? bvh_traverse(s, h, nodes + b.node_offset, triangles + b.triangle_offset, spheres + b.sphere_offset)
+               ? bvh_traverse(s, h, nodes, triangles, spheres)
                : -1;
     *s = world;
   }
+  return leaf;
+}
+
+/* Instance k against the ray: its bottom level walked with the object
+ * ray, for an identity instance (RTCL_INSTANCE_LINEAR_IDENTITY and a zero
+ * translation) the world ray itself, as the flat structure walks it.
+ * Records a nearer hit in h and k in *hit_instance; returns whether it
+ * recorded one (any hit: whether the instance blocks the ray). */
+inline int instance_visit(uint k, TraceRay* s, HitState* h, float tau, uint* hit_instance, INSTANCES_PARAMS) {
+  global const InstanceRecord* in = instances + k;
+  BottomLevel b = bottoms[in->bottom];
+  global const Bvh8Node* bottom_nodes = nodes + b.node_offset;
+  global const TriangleBlock* bottom_triangles = triangles + b.triangle_offset;
+  global const SphereBlock* bottom_spheres = spheres + b.sphere_offset;
+  float t_before = h->t_best;
+  int prim_before = h->prim;
+#ifdef RTCL_PRECISION_EXACT
+  double exact_before = h->t_exact;
+#endif
+  global const float* t = in->translation;
+  int identity = in->flags == RTCL_INSTANCE_LINEAR_IDENTITY && t[0] == 0.0f && t[1] == 0.0f && t[2] == 0.0f;
+  int leaf = identity ? bvh_traverse(s, h, bottom_nodes, bottom_triangles, bottom_spheres)
+                      : instance_walk_transformed(s, h, in, motions, tau, bottom_nodes, bottom_triangles,
+                                                  bottom_spheres);
   int found = h->t_best != t_before || h->prim != prim_before;
 #ifdef RTCL_PRECISION_EXACT
   found = found || h->t_exact != exact_before;

@@ -130,6 +130,7 @@ void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, cons
       }
     }
   }
+  run_through_motion(geometry, rays, check, options);
 }
 
 }  // namespace rtcl::test::everywhere

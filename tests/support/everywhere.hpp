@@ -33,6 +33,16 @@ struct RunOptions {
   // the fast level's answers are held to its bound below (with judge); false
   // only where the level promises none (needles and slivers)
   bool fast_bound = true;
+  // every ray starts inside a closed mesh or crosses one within its
+  // interval, so it hits wherever the geometry is placed: the motion pass
+  // (run_through_motion) holds its rays in every world to that
+  bool every_ray_hits = false;
+  // the motion pass judges the rays in the worlds of its other times too;
+  // false where they lie in or graze face planes by construction: there
+  // the rounding of a moved instance's object ray (its documented error,
+  // docs/scenes-and-instances.md, "Precision") decides hit or miss, and
+  // the pass judges them at its identity time alone
+  bool judge_moved = true;
 };
 
 // The fast level's bound (docs/precision.md: the measured maxima), over
@@ -68,7 +78,23 @@ void expect_at_level(Precision level, bool must_pass, const std::string& what, c
 // (expect_within_fast_bound). The judge's verdict depends only on the answer, so
 // brute force's answers are judged in full and another structure's only
 // where they differ (same t, another primitive sharing an edge or vertex).
+// Then the same rays go through moving instances (run_through_motion).
 void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, const Check& check,
                     RunOptions options = {});
+
+// The motion pass: the geometry as the mesh of two coincident two-keyframe
+// instances (rtcl::Scene, the BVH bottom level, through the top level),
+// whose blended transform is exactly the identity at time 0.5 and turns,
+// shears, scales and moves the mesh at 0, 0.25, 0.75 and 1 (a uniform
+// scale and a move for a geometry with spheres). At every level and both
+// queries: the rays at time 0.5 pass the judge on the geometry and
+// `check`; each ray placed in the world of one of the other times (its
+// origin and direction mapped in double, the interval kept), traced at
+// that time, passes the judge on the geometry placed at that time (the
+// reference of the scene interpolated at the ray's time; with
+// judge_moved), and with every_ray_hits hits. The fast level as
+// run_everywhere treats it.
+void run_through_motion(const Geometry& geometry, const std::vector<Ray>& rays, const Check& check,
+                        const RunOptions& options);
 
 }  // namespace rtcl::test::everywhere
