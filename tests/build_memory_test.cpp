@@ -6,7 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <cstdint>
+#include <fstream>
 #include <string>
 
 #include "rtcl/accel.hpp"
@@ -61,6 +64,28 @@ TEST(BuildMemory, TheEnvironmentLowersTheHostLimit) {
     EXPECT_EQ(error_of([] { available_host_bytes(); }),
               std::string("RTCL_MAX_HOST_BYTES='") + bad + "': expected a positive number of bytes");
   }
+}
+
+// An address-space limit (prlimit --as, ulimit -v) bounds what a build may
+// still map: the limit less what the process maps now.
+TEST(BuildMemory, TheAddressSpaceLimitBoundsTheHostLimit) {
+  rlimit saved{};
+  ASSERT_EQ(getrlimit(RLIMIT_AS, &saved), 0);
+  const std::size_t margin = std::size_t(256) << 20;
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  std::size_t mapped = 0;
+  while (std::getline(status, line))
+    if (line.rfind("VmSize:", 0) == 0) mapped = std::stoull(line.substr(7)) * 1024;
+  ASSERT_GT(mapped, 0u);
+  if (saved.rlim_max != RLIM_INFINITY && saved.rlim_max < mapped + margin) GTEST_SKIP() << "hard limit too low";
+  rlimit lowered = saved;
+  lowered.rlim_cur = mapped + margin;
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &lowered), 0);
+  const std::size_t available = available_host_bytes();
+  ASSERT_EQ(setrlimit(RLIMIT_AS, &saved), 0);
+  EXPECT_LE(available, margin);
+  EXPECT_GE(available, margin / 2) << "the process mapped little between the two readings";
 }
 
 // Every structure refuses before building when the host cannot hold the

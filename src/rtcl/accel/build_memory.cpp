@@ -26,8 +26,10 @@ std::size_t proc_kilobytes(const char* path, std::string_view key) {
   while (std::getline(in, line))
     if (line.size() > key.size() && line.compare(0, key.size(), key) == 0 && line[key.size()] == ':') {
       std::size_t kb = 0;
-      const char* first = line.data() + line.find_first_not_of(' ', key.size() + 1);
-      if (std::from_chars(first, line.data() + line.size(), kb).ec == std::errc()) return kb * 1024;
+      const std::size_t digits = line.find_first_not_of(" \t", key.size() + 1);  // /proc/self/status: a tab
+      if (digits != std::string::npos &&
+          std::from_chars(line.data() + digits, line.data() + line.size(), kb).ec == std::errc())
+        return kb * 1024;
     }
   return SIZE_MAX;
 }
@@ -43,9 +45,9 @@ std::size_t available_host_bytes() {
   std::size_t available = proc_kilobytes("/proc/meminfo", "MemAvailable");
   rlimit limit{};
   if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
-    std::size_t mapped = proc_kilobytes("/proc/self/status", "VmSize");
-    std::size_t cap = static_cast<std::size_t>(limit.rlim_cur);
-    available = std::min(available, mapped == SIZE_MAX || mapped >= cap ? 0 : cap - mapped);
+    const std::size_t mapped = proc_kilobytes("/proc/self/status", "VmSize");
+    const auto cap = static_cast<std::size_t>(limit.rlim_cur);
+    if (mapped != SIZE_MAX) available = std::min(available, mapped >= cap ? 0 : cap - mapped);
   }
   if (const char* text = std::getenv("RTCL_MAX_HOST_BYTES"); text && *text) {
     std::size_t value = 0;
