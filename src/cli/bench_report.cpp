@@ -217,8 +217,8 @@ std::string bench_markdown(const BenchRun& run) {
                    " kernel launches after a warm-up (OpenCL event times), precision " + run.precision +
                    "; build: host ms, median of " + std::to_string(build_count(run.repeat)) + " builds, each after a " +
                    std::to_string(kBuildPause.count()) +
-                   " ms pause; B/prim: device bytes per primitive; peak B/prim: the rise of the process's peak resident memory "
-                   "during the last build, per primitive; check: rays agreeing with brute force" +
+                   " ms pause; B/prim: device bytes per primitive; peak B/prim: the rise of the process's peak "
+                   "resident memory during the last build, per primitive; check: rays agreeing with brute force" +
                    (run.diffuse_sort != "never"
                         ? "; diffuse rays traced as scattered calls, sorted on the device " +
                               std::string(run.diffuse_sort == "always" ? "always"
