@@ -1,11 +1,13 @@
 #!/bin/sh
 # The build-scaling table and plot (docs/benchmarks.md, "Build times"):
 # `rtcl bench` on random soups and the tessellated surface of 1M, 4M, 16M
-# and 32M triangles, each scene in its own process (so that one scene's
-# memory never counts in another's), every structure of $ACCELS against
-# Embree's default build of the same scene, primary rays checked against
-# brute force; then the table (bench/scaling_table.py) and the plot
-# (bench/plot_bench.py, OUT/bench-build.png).
+# and 32M triangles, each scene and structure of $ACCELS in its own process
+# (a build's peak memory is measured as the rise of the process's peak
+# resident memory, which memory freed earlier in the same process would
+# hide), against Embree's default build of the same scene in the same
+# process, primary rays checked against brute force; then the table
+# (bench/scaling_table.py) and the plot (bench/plot_bench.py,
+# OUT/bench-build.png).
 #
 #   bench/scaling.sh [OUT]        (default OUT: scaling)
 #
@@ -23,9 +25,11 @@ REPEAT=${REPEAT:-3}
 mkdir -p "$OUT"
 for scene in $SCENES; do
   for n in $SIZES; do
-    "$RTCL" bench --scene "$scene:count=$n" --accel "$ACCELS" --rays primary --size 256 --repeat "$REPEAT" \
-      --check-rays 256 -q -o "$OUT/$scene-$n" > /dev/null
-    echo "written: $OUT/$scene-$n/bench.json"
+    for accel in $(echo "$ACCELS" | tr ',' ' '); do
+      "$RTCL" bench --scene "$scene:count=$n" --accel "$accel" --rays primary --size 256 --repeat "$REPEAT" \
+        --check-rays 256 -q -o "$OUT/$scene-$n-$accel" > /dev/null
+      echo "written: $OUT/$scene-$n-$accel/bench.json"
+    done
   done
 done
 /usr/bin/python3 "$(dirname "$0")/scaling_table.py" "$OUT"/*/bench.json | tee "$OUT/scaling.md"
