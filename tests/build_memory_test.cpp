@@ -104,7 +104,7 @@ TEST(BuildMemory, EveryStructureChecksTheHostBeforeBuilding) {
   }
 }
 
-// The estimate is a lower bound: a scene the host holds is never refused.
+// A scene well within the limit is built by every structure.
 TEST(BuildMemory, AFittingSceneBuildsUnderATightButSufficientLimit) {
   Device device = Device::open();
   Geometry surface = tessellated_surface(20000);

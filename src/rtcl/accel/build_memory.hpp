@@ -4,12 +4,15 @@
 // instead of being left to the kernel's out-of-memory killer or to a
 // failed upload after minutes of building.
 //
-// The estimates are per primitive and deliberately low (rounded down from
-// the peaks `rtcl bench` measures, build_peak_bytes, on the random soup
-// and the tessellated surface at 1M-4M triangles), so that a scene that
-// fits is never refused; a scene near the limit may still run out where a
-// structure's reference count depends on the geometry (grid, octrees,
-// kd-trees), and is then stopped by the device's own buffer checks.
+// The estimates are per triangle (a sphere counts half): the peaks `rtcl
+// bench` measures (build_peak_bytes, device_bytes) on the random soup and
+// on the tessellated surface of 1M triangles, the larger of the two. The
+// largest buffer's is a true lower bound (every structure stores each
+// triangle once in 40-byte block lanes). A scene within a few percent of
+// the limit may be refused or may still run out; where a structure's
+// reference count depends on the geometry (grid, octrees, BSP, kd-trees)
+// a scene unlike both can need more, and is then stopped by the
+// structure's own reference and buffer checks.
 //
 // Host memory available to a build: MemAvailable of /proc/meminfo, and
 // no more than the address-space limit (RLIMIT_AS, `prlimit --as`) leaves
