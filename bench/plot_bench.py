@@ -4,10 +4,14 @@ docs/benchmarks.md):
 
   PREFIX-mrays.png  Mrays/s (kernel time, median with min-max bars) per
                     structure per scene, one panel per ray set and device;
-  PREFIX-build.png  host build time against primitive count, one line per
-                    structure and one for Embree's build when the run has
-                    its baseline (run e.g. --scene soup:count=1000,...,
-                    soup:count=4000000 to see how each build grows);
+  PREFIX-build.png  build scaling against primitive count, one line per
+                    structure and scene family (soup, surface, ...) and
+                    one for Embree's build when the run has its baseline:
+                    host build time, the peak memory the build adds per
+                    primitive (build_peak_bytes) and the primary rays'
+                    rate (run e.g. --scene soup:count=1000000,...,
+                    soup:count=33554432; docs/benchmarks.md, "Build
+                    times");
   PREFIX-embree.png rtcl / Embree per structure per scene (the cell's
                     "embree" ratio: single-ray kernels against rtcIntersect1
                     / rtcOccluded1, packet kernels against rtcIntersect8 /
@@ -60,6 +64,8 @@ def load(paths):
                 robust = " (robust)" if embree.get("flags") == "robust" else ""
                 cells.append({"device_label": f"host, {cpu}", "accel": f"Embree {embree['version']}{robust}",
                               "scene": b["scene"], "rays": b["rays"], "build_ms": b["build_ms"],
+                              "build_peak_bytes": b.get("build_peak_bytes", 0),
+                              "rate": b["mrays_per_s"]["trace"]["median"],
                               "scene_primitives": prims.get(b["scene"], 0), "baseline": True})
     return cells
 
@@ -107,21 +113,42 @@ def plot_rates(cells, path):
 
 
 def plot_build(cells, path):
-    # One point per (device, structure, scene): the build does not depend on the ray set.
+    """Build time, peak build memory per primitive and primary-ray rate
+    against primitive count: one line per (device, structure, scene family),
+    the family being the scene's name before ':' (soup, surface, ...)."""
     points = defaultdict(dict)
+    rates = defaultdict(dict)
     for c in cells:
-        points[(c["device_label"], c["accel"])][c["scene"]] = (c["scene_primitives"], c["build_ms"])
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for (device, accel), by_scene in sorted(points.items()):
+        key = (c["device_label"], c["accel"], c["scene"].split(":")[0])
+        prims = c["scene_primitives"]
+        peak = c.get("build_peak_bytes", 0) / prims if prims else 0.0
+        points[key][c["scene"]] = (prims, c["build_ms"], peak)
+        if c["rays"] == "primary":
+            rate = c["rate"] if c.get("baseline") else c["mrays_per_s"]["kernel"]["median"]
+            rates[key][c["scene"]] = (prims, rate)
+    fig, axes = plt.subplots(1, 3, figsize=(16, 6))
+    for key, by_scene in sorted(points.items()):
+        device, accel, family = key
+        label = f"{accel}, {family} ({device})"
         xy = sorted(by_scene.values())
-        ax.plot([p[0] for p in xy], [p[1] for p in xy], marker="o", label=f"{accel} ({device})")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("primitives")
-    ax.set_ylabel("host build time (ms)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
+        axes[0].plot([p[0] for p in xy], [p[1] for p in xy], marker="o", label=label)
+        peaks = [p for p in xy if p[2] > 0]
+        axes[1].plot([p[0] for p in peaks], [p[2] for p in peaks], marker="o", label=label)
+        r = sorted(rates[key].values())
+        axes[2].plot([p[0] for p in r], [p[1] for p in r], marker="o", label=label)
+    for ax, ylabel, log in ((axes[0], "host build time (ms)", True),
+                            (axes[1], "peak build memory (bytes / primitive)", False),
+                            (axes[2], "primary rays (Mrays/s)", True)):
+        ax.set_xscale("log")
+        if log:
+            ax.set_yscale("log")
+        ax.set_xlabel("primitives")
+        ax.set_ylabel(ylabel)
+        ax.grid(True, which="both", alpha=0.3)
+    handles, labels = axes[0].get_legend_handles_labels()
+    rows = (len(labels) + 2) // 3
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize=7)
+    fig.tight_layout(rect=(0, min(0.5, 0.035 * rows + 0.02), 1, 1))
     fig.savefig(path, dpi=110)
     print(f"written: {path}")
 

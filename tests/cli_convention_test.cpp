@@ -102,6 +102,11 @@ TEST(CliExitCodes, OptionValueOutOfRangeExits2AndWhatTheDeviceCannotHoldExits1) 
   // In range, but more than the device holds: the run fails (exit 1).
   expect_exit(run_cli(in.dir, in.trace(), "RTCL_MAX_ALLOC_BYTES=64"), 1, "exceed the largest buffer", in.dir,
               "out.hits");
+  // More than the host holds during the build: refused before the build and before any output.
+  expect_exit(run_cli(in.dir, in.trace(), "RTCL_MAX_HOST_BYTES=64"), 1, "bytes of host memory at its peak, more than "
+              "the 64 bytes available", in.dir, "out.hits");
+  expect_exit(run_cli(in.dir, {"bench", "--scene", "tetra:levels=1", "-o", "b"}, "RTCL_MAX_HOST_BYTES=64"), 1,
+              "bytes of host memory at its peak", in.dir, "b/bench.json");
 }
 
 TEST(CliExitCodes, UnknownPrecisionExits2AndOneInASceneFileExits1) {

@@ -1,7 +1,8 @@
 // The procedural scenes (src/rtcl/scene/procedural.cpp) against their closed
 // forms: primitive counts, the sphereflake's touching and disjoint spheres,
 // the Sierpinski tetrahedron's constant area, the mountain's crack-free
-// surface and height bound; bad sizes refused; and the BVH agreeing with
+// surface and height bound, the tessellated surface's closed displaced
+// torus; bad sizes refused; and the BVH agreeing with
 // brute force on them (the tetrahedra meet in single shared points).
 #include <gtest/gtest.h>
 
@@ -92,6 +93,29 @@ TEST(Procedural, FractalMountainHasNoCracksAndStaysWithinItsRoughness) {
   EXPECT_NE(fractal_mountain(4, 9).vertices, fractal_mountain(4, 10).vertices);
 }
 
+TEST(Procedural, TessellatedSurfaceIsAClosedDisplacedTorus) {
+  for (std::size_t count : {std::size_t(18), std::size_t(1000), std::size_t(20000)}) {
+    Geometry g = tessellated_surface(count);
+    const std::size_t nv = std::max<std::size_t>(3, std::llround(std::sqrt(count / 8.0)));
+    const std::size_t nu = std::max<std::size_t>(3, std::llround(count / (2.0 * nv)));
+    ASSERT_EQ(g.triangles.size(), 2 * nu * nv) << count;
+    ASSERT_EQ(g.vertices.size(), nu * nv);
+    EXPECT_EQ(validate(g).zero_area_triangles, 0u);
+    // closed: every edge is shared by exactly two triangles
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+    for (const glm::uvec3& t : g.triangles)
+      for (auto [a, b] : {std::pair(t.x, t.y), std::pair(t.y, t.z), std::pair(t.z, t.x)})
+        ++edges[{std::min(a, b), std::max(a, b)}];
+    for (const auto& [e, n] : edges) ASSERT_EQ(n, 2) << count;
+    // every vertex within the bumps (+-0.03) of the tube (radius 0.3) around the unit ring
+    for (const glm::vec3& v : g.vertices) {
+      double ring = std::hypot(double(v.x), double(v.z)) - 1.0, tube = std::hypot(ring, double(v.y));
+      ASSERT_NEAR(tube, 0.3, 0.03 + 1e-6);
+    }
+  }
+  EXPECT_EQ(tessellated_surface(1000000).triangles.size(), 999696u) << "within 0.1% of the count from 1M";
+}
+
 TEST(Procedural, SoupAndStadium) {
   Geometry soup = random_triangle_soup(1000, 4);
   ASSERT_EQ(soup.triangles.size(), 1000u);
@@ -112,12 +136,13 @@ TEST(Procedural, BadSizesAreErrors) {
   EXPECT_EQ(error_of([] { sierpinski_tetrahedron(-1); }), "tetra: levels=-1: must be in [0, 10]");
   EXPECT_EQ(error_of([] { fractal_mountain(11); }), "mount: levels=11: must be in [0, 10]");
   EXPECT_EQ(error_of([] { random_triangle_soup(0); }), "soup: count=0: must be in [1, 67108864]");
+  EXPECT_EQ(error_of([] { tessellated_surface(17); }), "surface: count=17: must be in [18, 67108864]");
   Geometry g = sierpinski_tetrahedron(0);
   EXPECT_EQ(error_of([&] { add_stadium(g, 1.0f); }), "stadium: scale=1.000000: must be finite and > 1");
 }
 
 TEST(Procedural, TheBvhMatchesBruteForceOnThem) {
-  for (Geometry g : {sphereflake(2), sierpinski_tetrahedron(3), fractal_mountain(4)}) {
+  for (Geometry g : {sphereflake(2), sierpinski_tetrahedron(3), fractal_mountain(4), tessellated_surface(5000)}) {
     std::vector<Ray> rays = random_rays(g, 3000, 8);
     auto brute = make_brute(test_device(), g, {});
     auto bvh = make_accel(test_device(), "bvh", g);

@@ -29,6 +29,7 @@
 #include "distributed.hpp"
 #include "flag_names.hpp"
 #include "option_checks.hpp"
+#include "peak_memory.hpp"
 #include "progress.hpp"
 #include "rtcl/accel.hpp"
 #include "bench/support/ray_sets.hpp"
@@ -311,11 +312,14 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
   std::unique_ptr<Accel> accel;
   std::vector<double> build_ms_runs, embree_build_ms_runs;
   double setup = 0.0;
+  std::size_t peak_bytes = 0;
   for (int b = 0; b < build_count(repeat); ++b) {
     accel.reset();
     std::this_thread::sleep_for(kBuildPause);
     Clock::time_point start = Clock::now();
+    PeakMemory peak;
     accel = make_accel(device, accel_name, scene.scene.geometry, config);
+    peak_bytes = peak.peak_extra_bytes();
     if (b == 0) setup = ms_since(start) - accel->stats().build_ms;
     build_ms_runs.push_back(accel->stats().build_ms);
     if (embree) {
@@ -339,6 +343,7 @@ std::vector<BenchCell> bench_structure(const Device& device, std::size_t device_
     cell.setup_ms = std::max(0.0, setup);
     cell.device_bytes = stats.device_bytes;
     cell.primitives = stats.primitive_count;
+    cell.build_peak_bytes = peak_bytes;
     cell.packets = accel->rays_per_work_item(Coherence::incoherent) > 1;
     if (kind_query(k) == Query::any) cell.occluder_run = accel->occluder_run(Coherence::incoherent);
     Coherence coherence = k == 2 ? Coherence::scattered : Coherence::incoherent;

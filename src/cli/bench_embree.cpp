@@ -3,6 +3,7 @@
 #include <chrono>
 #include <thread>
 
+#include "peak_memory.hpp"
 #include "rtcl/error.hpp"
 
 #ifdef RTCL_HAVE_EMBREE
@@ -31,7 +32,9 @@ EmbreeBaseline::EmbreeBaseline(const Geometry& geometry, unsigned threads, bool 
   for (int b = 0; b < builds; ++b) {
     impl_.reset();
     std::this_thread::sleep_for(kBuildPause);
+    PeakMemory peak;
     impl_.reset(new Impl{bench::EmbreeScene(geometry, bench::EmbreeQuality::standard, threads, robust)});
+    build_peak_bytes_ = peak.peak_extra_bytes();
     build_ms_runs_.push_back(impl_->scene.build_ms());
   }
   if (!impl_) throw Error("Embree baseline: no build");
@@ -54,6 +57,7 @@ std::vector<Hit> EmbreeBaseline::measure(Query query, bool packets, const std::v
   out.build_ms = spread_of(build_ms_runs_).median;
   out.build_ms_runs = build_ms_runs_;
   out.bytes = embree.bytes();
+  out.build_peak_bytes = build_peak_bytes_;
   std::vector<Hit> hits(rays.size());
   if (rays.empty()) return hits;
   embree.trace(query, rays.data(), hits.data(), rays.size(), threads_, api);  // warm-up: page-in, threads

@@ -26,7 +26,8 @@ class EmbreeBaseline {
   // Builds Embree's scene of the geometry's triangles and spheres (its default, medium
   // quality build on `threads` threads; `robust`: with
   // RTC_SCENE_FLAG_ROBUST, Embree's watertight mode) `builds` times, each
-  // after kBuildPause, and keeps the last.
+  // after kBuildPause, and keeps the last (its peak memory: the figures'
+  // build_peak_bytes).
   EmbreeBaseline(const Geometry& geometry, unsigned threads, bool robust, int builds);
   ~EmbreeBaseline();
   EmbreeBaseline(const EmbreeBaseline&) = delete;
@@ -59,6 +60,7 @@ class EmbreeBaseline {
   unsigned threads_;
   bool robust_;
   std::vector<double> build_ms_runs_;
+  std::size_t build_peak_bytes_ = 0;  // of the last build (peak_memory.hpp)
 };
 
 }  // namespace rtcl::cli

@@ -77,6 +77,7 @@ json baseline_json(const BenchBaseline& b) {
           {"build_ms", b.build_ms},
           {"build_ms_runs", b.build_ms_runs},
           {"bytes", b.bytes},
+          {"build_peak_bytes", b.build_peak_bytes},
           {"trace_ms", spread_json(trace)},
           {"wall_ms", spread_json(wall)},
           {"mrays_per_s", {{"trace", spread_json(rate_of(b.ray_count, trace))},
@@ -109,6 +110,9 @@ json cell_json(const BenchCell& c, const BenchBaseline* baseline) {
       {"primitives", c.primitives},
       {"bytes_per_primitive",
        c.primitives ? static_cast<double>(c.device_bytes) / static_cast<double>(c.primitives) : 0.0},
+      {"build_peak_bytes", c.build_peak_bytes},
+      {"build_peak_bytes_per_primitive",
+       c.primitives ? static_cast<double>(c.build_peak_bytes) / static_cast<double>(c.primitives) : 0.0},
       {"kernel_ms", spread_json(kernel)},
       {"kernel_timer", c.profiled ? "opencl-events" : "host-clock"},
       {"wall_ms", spread_json(wall)},
@@ -213,7 +217,8 @@ std::string bench_markdown(const BenchRun& run) {
                    " kernel launches after a warm-up (OpenCL event times), precision " + run.precision +
                    "; build: host ms, median of " + std::to_string(build_count(run.repeat)) + " builds, each after a " +
                    std::to_string(kBuildPause.count()) +
-                   " ms pause; B/prim: device bytes per primitive; check: rays agreeing with brute force" +
+                   " ms pause; B/prim: device bytes per primitive; peak B/prim: the rise of the process's peak "
+                   "resident memory during the last build, per primitive; check: rays agreeing with brute force" +
                    (run.diffuse_sort != "never"
                         ? "; diffuse rays traced as scattered calls, sorted on the device " +
                               std::string(run.diffuse_sort == "always" ? "always"
@@ -230,9 +235,9 @@ std::string bench_markdown(const BenchRun& run) {
   for (std::size_t d = 0; d < run.devices.size(); ++d) {
     const BenchDevice& device = run.devices[d];
     md += "\n### [" + std::to_string(device.index) + "] " + device.name + " (" + device.platform + ", driver " +
-          device.driver + ")\n\n| scene | structure | build ms | B/prim |";
+          device.driver + ")\n\n| scene | structure | build ms | B/prim | peak B/prim |";
     for (const std::string& rays : run.ray_kinds) md += " " + rays + " |";
-    md += " check |\n|---|---|---:|---:|";
+    md += " check |\n|---|---|---:|---:|---:|";
     for (std::size_t i = 0; i < run.ray_kinds.size(); ++i) md += "---:|";
     md += "---|\n";
     for (const std::string& scene : run.scenes)
@@ -269,15 +274,18 @@ std::string bench_markdown(const BenchRun& run) {
                                             : 0.0;
         std::string build = format(" %.1f", first->build_ms);
         if (build_ratio(*first) > 0.0) build += format(" x%.2fE", build_ratio(*first));
-        md += "| " + scene + " | " + accel + " |" + build + " |" + format(" %.1f |", per_prim) + row + " " + check +
-              " |\n";
+        double peak_per_prim = first->primitives ? static_cast<double>(first->build_peak_bytes) /
+                                                       static_cast<double>(first->primitives)
+                                                 : 0.0;
+        md += "| " + scene + " | " + accel + " |" + build + " |" + format(" %.1f |", per_prim) +
+              format(" %.1f |", peak_per_prim) + row + " " + check + " |\n";
       }
   }
   if (!run.embree.empty()) {
     md += "\n### Embree " + run.embree_version + " on the host (" + std::to_string(run.embree.front().threads) +
-          " threads)\n\n| scene | API | build ms | B/prim |";
+          " threads)\n\n| scene | API | build ms | B/prim | peak B/prim |";
     for (const std::string& rays : run.ray_kinds) md += " " + rays + " |";
-    md += " check |\n|---|---|---:|---:|";
+    md += " check |\n|---|---|---:|---:|---:|";
     for (std::size_t i = 0; i < run.ray_kinds.size(); ++i) md += "---:|";
     md += "---|\n";
     for (const std::string& scene : run.scenes)
@@ -309,8 +317,9 @@ std::string bench_markdown(const BenchRun& run) {
         std::string check = disagreeing == 0 ? "ok " + std::to_string(checked)
                                              : "**DISAGREES " + std::to_string(disagreeing) + "/" +
                                                    std::to_string(checked) + "**";
+        double peak_per_prim = prims ? static_cast<double>(first->build_peak_bytes) / static_cast<double>(prims) : 0.0;
         md += "| " + scene + " | " + api + " |" + format(" %.1f |", first->build_ms) + format(" %.1f |", per_prim) +
-              row + " " + check + " |\n";
+              format(" %.1f |", peak_per_prim) + row + " " + check + " |\n";
       }
   }
   for (const BenchInstances& i : run.instances) {

@@ -46,6 +46,10 @@ struct BenchCell {
   double first_launch_ms = 0.0;  // the warm-up launch, wall: includes the query's program build at its first use
   std::size_t device_bytes = 0;
   std::size_t primitives = 0;
+  // How far the process's peak resident memory rose during the last build
+  // (make_accel: build, flatten and upload; peak_memory.hpp); 0 where the
+  // kernel cannot reset the peak.
+  std::size_t build_peak_bytes = 0;
   std::vector<double> kernel_ms, wall_ms;  // per timed launch, in launch order
   bool profiled = false;                   // kernel_ms from OpenCL events (else the host clock)
   std::size_t checked = 0, disagreeing = 0;  // rays compared with brute force, and those that differ
@@ -76,6 +80,7 @@ struct BenchBaseline {
   double build_ms = 0.0;   // rtcCommitScene and geometry setup, wall: the median of build_ms_runs
   std::vector<double> build_ms_runs;  // each build of the scene, after kBuildPause
   std::size_t bytes = 0;   // Embree's memory after the build (its memory monitor)
+  std::size_t build_peak_bytes = 0;  // the rise of peak resident memory during the last build (as BenchCell's)
   std::vector<double> trace_ms, wall_ms;  // per timed trace: the traversal alone; with the ray and answer conversions
   std::size_t checked = 0, disagreeing = 0;
 };

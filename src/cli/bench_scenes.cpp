@@ -22,6 +22,7 @@ constexpr Procedural procedurals[] = {
     {"tetra", "levels", 6, 0, 11},
     {"mount", "levels", 6, 0, 11},
     {"soup", "count", 100000, 1, std::int64_t{1} << 26},
+    {"surface", "count", 1000000, 18, std::int64_t{1} << 26},
 };
 
 const Procedural* find_procedural(const std::string& kind) {
@@ -112,6 +113,8 @@ LoadedBenchScene load_bench_scene(const BenchSceneSpec& spec) {
     scene.geometry = sierpinski_tetrahedron(static_cast<int>(spec.size));
   } else if (spec.kind == "mount") {
     scene.geometry = fractal_mountain(static_cast<int>(spec.size));
+  } else if (spec.kind == "surface") {
+    scene.geometry = tessellated_surface(static_cast<std::size_t>(spec.size));
   } else {
     scene.geometry = random_triangle_soup(static_cast<std::size_t>(spec.size));
   }

@@ -23,6 +23,10 @@ constexpr unsigned kMaxMacro = 256;
 // Positions past the last reference lane: a float8 run starting at the last
 // reference stays inside its row.
 constexpr std::size_t kLanePadding = RTCL_BLOCK_WIDTH;
+// The kernel indexes a lane row as row * lane_stride in int (triangle.h,
+// intersect_triangle_run): the 9 rows of lane_stride floats stay below 2^31
+// whatever the device's largest buffer.
+constexpr std::size_t kMaxLaneRefs = 0x7fffffffu / 9 - kLanePadding;
 
 std::string resolution_text(const GridResolution& r) {
   return std::to_string(r[0]) + "x" + std::to_string(r[1]) + "x" + std::to_string(r[2]);
@@ -278,6 +282,8 @@ Grid build_grid(const Geometry& geometry, const GridConfig& config) {
   std::size_t max_refs = config.max_alloc_bytes ? config.max_alloc_bytes / (9 * sizeof(float)) : kMaxCells;
   max_refs = max_refs > kLanePadding ? max_refs - kLanePadding : 0;
   max_refs = std::min<std::size_t>(max_refs, kMaxCells);
+  const bool index_bound = max_refs > kMaxLaneRefs;
+  max_refs = std::min(max_refs, kMaxLaneRefs);
 
   // Pass 1 (parallel over contiguous triangle ranges): (cell, ref) pairs.
   unsigned threads = config.thread_count ? config.thread_count : 2;
@@ -307,7 +313,11 @@ Grid build_grid(const Geometry& geometry, const GridConfig& config) {
   }
   std::size_t ref_count = 0;
   for (const auto& p : parts) ref_count += p.size();
-  if (ref_count > max_refs || std::find(overflow.begin(), overflow.end(), 1) != overflow.end())
+  const bool overflowed = ref_count > max_refs || std::find(overflow.begin(), overflow.end(), 1) != overflow.end();
+  if (overflowed && index_bound)
+    throw Error("grid over " + geometry.source + ": " + option + ": more than " + std::to_string(max_refs) +
+                " cell references, more than the reference lanes' 32-bit indices hold; use a smaller lambda or res");
+  if (overflowed)
     too_large(geometry, option, "more than " + std::to_string(max_refs) + " cell references (9 floats each)",
               std::uint64_t(max_refs + 1 + kLanePadding) * 9 * sizeof(float),
               (max_refs + kLanePadding) * 9 * sizeof(float));

@@ -1,11 +1,16 @@
 // The one list of structures make_accel knows. A new structure adds its
 // builder file (with its StructureSpec: name, summary, options), its kernel
-// file and one line here.
+// file and one line here, with its build's memory per triangle
+// (build_memory.hpp: host peak, device total, largest device buffer; the
+// larger of what `rtcl bench` measures, peak resident memory and
+// device_bytes, on a random soup and on the tessellated surface of 1M
+// triangles, rounded down to 8 bytes).
 #include <functional>
 
 #include "rtcl/accel.hpp"
 #include "rtcl/accel/brute.hpp"
 #include "rtcl/accel/bsp.hpp"
+#include "rtcl/accel/build_memory.hpp"
 #include "rtcl/accel/bvh.hpp"
 #include "rtcl/accel/bvh_mixed.hpp"
 #include "rtcl/accel/grid.hpp"
@@ -24,22 +29,27 @@ using Factory = std::function<std::unique_ptr<Accel>(const Device&, const Geomet
 struct Entry {
   const StructureSpec& spec;
   Factory make;
+  BuildFootprint footprint;
 };
 
 const std::vector<Entry>& registry() {
+  // Footprints: bytes per triangle at the build's peak on the host beyond
+  // the geometry, of the structure on the device, and of its largest buffer
+  // (the triangle blocks, 320 bytes per 8, in every structure).
   static const std::vector<Entry> entries = {
-      {brute_structure(), [](const Device& d, const Geometry& g, const AccelConfig& c) { return make_brute(d, g, c); }},
-      {bvh_structure(), make_bvh_sah},
-      {bvh_ploc_structure(), make_bvh_ploc},
-      {bvh_packet_structure(), make_bvh_packet},
-      {bvh_mixed_structure(), make_bvh_mixed},
-      {grid_structure(), make_grid_accel},
-      {octree_structure(), make_octree_accel},
-      {octree_ptr_structure(), make_octree_ptr_accel},
-      {octree_r_structure(), make_octree_r_accel},
-      {bsp_structure(), make_bsp_accel},
-      {kdtree_structure(), make_kdtree_accel},
-      {kdtree_packet_structure(), make_kdtree_packet_accel},
+      {brute_structure(), [](const Device& d, const Geometry& g, const AccelConfig& c) { return make_brute(d, g, c); },
+       {40, 40, 40}},
+      {bvh_structure(), make_bvh_sah, {112, 48, 40}},
+      {bvh_ploc_structure(), make_bvh_ploc, {136, 56, 40}},
+      {bvh_packet_structure(), make_bvh_packet, {112, 48, 40}},
+      {bvh_mixed_structure(), make_bvh_mixed, {112, 56, 40}},
+      {grid_structure(), make_grid_accel, {336, 224, 40}},
+      {octree_structure(), make_octree_accel, {224, 120, 40}},
+      {octree_ptr_structure(), make_octree_ptr_accel, {224, 120, 40}},
+      {octree_r_structure(), make_octree_r_accel, {240, 112, 40}},
+      {bsp_structure(), make_bsp_accel, {552, 328, 40}},
+      {kdtree_structure(), make_kdtree_accel, {200, 72, 40}},
+      {kdtree_packet_structure(), make_kdtree_packet_accel, {200, 72, 40}},
   };
   return entries;
 }
@@ -84,6 +94,9 @@ std::unique_ptr<Accel> make_accel(const Device& device, std::string_view name, c
   if (!entry) throw Error("internal: structure " + spec.name + " has no factory");
   full.options = resolve_options(entry->spec, full.options, context);
   require_precision(device.info(), config.precision);  // before the build; the Accel base checks it for bvh-motion
+  // A sphere's block lane is half a triangle's (SphereBlock, TriangleBlock).
+  check_build_memory(entry->footprint, geometry.triangles.size() + (geometry.spheres.size() + 1) / 2,
+                     context + " over " + geometry.source, device);
   return entry->make(device, geometry, full);
 }
 

@@ -153,6 +153,36 @@ Geometry random_triangle_soup(std::size_t count, std::uint32_t seed) {
   return g;
 }
 
+Geometry tessellated_surface(std::size_t count) {
+  if (count < 18 || count > (std::size_t(1) << 26))
+    throw Error("surface: count=" + std::to_string(count) + ": must be in [18, 67108864]");
+  const std::size_t nv = std::max<std::size_t>(3, std::llround(std::sqrt(static_cast<double>(count) / 8.0)));
+  const std::size_t nu = std::max<std::size_t>(3, std::llround(static_cast<double>(count) / (2.0 * nv)));
+  constexpr double pi = 3.14159265358979323846, ring = 1.0, tube = 0.3, bump = 0.03;
+  Geometry g;
+  g.source = "surface:count=" + std::to_string(count);
+  g.vertices.reserve(nu * nv);
+  g.triangles.reserve(2 * nu * nv);
+  for (std::size_t i = 0; i < nu; ++i) {
+    const double u = 2.0 * pi * static_cast<double>(i) / static_cast<double>(nu);
+    for (std::size_t j = 0; j < nv; ++j) {
+      const double v = 2.0 * pi * static_cast<double>(j) / static_cast<double>(nv);
+      // Periodic in u and v, so the seam closes: integer frequencies only.
+      const double r = tube + bump * (0.6 * std::sin(13.0 * u) * std::sin(5.0 * v) +
+                                      0.4 * std::sin(41.0 * u + 3.0 * v) * std::cos(11.0 * v));
+      const double w = ring + r * std::cos(v);
+      g.vertices.push_back(glm::vec3(glm::dvec3(w * std::cos(u), r * std::sin(v), w * std::sin(u))));
+    }
+  }
+  auto at = [&](std::size_t i, std::size_t j) { return static_cast<std::uint32_t>((i % nu) * nv + j % nv); };
+  for (std::size_t i = 0; i < nu; ++i)
+    for (std::size_t j = 0; j < nv; ++j) {
+      g.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      g.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  return g;
+}
+
 void add_stadium(Geometry& g, float scale) {
   if (!(scale > 1.0f) || !std::isfinite(scale))
     throw Error("stadium: scale=" + std::to_string(scale) + ": must be finite and > 1");

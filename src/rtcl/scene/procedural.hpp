@@ -42,6 +42,15 @@ Geometry fractal_mountain(int levels, std::uint32_t seed = 1, float roughness = 
 // count^(-1/3)), up to 2^26.
 Geometry random_triangle_soup(std::size_t count, std::uint32_t seed = 1);
 
+// A tessellated surface: a torus (ring radius 1, tube radius 0.3, about the
+// y axis) whose tube radius is displaced by a smooth closed-form bump field
+// (+-0.03), as a closed connected mesh of nu x nv grid quads, two triangles
+// each, every vertex shared by six triangles: the realistic large mesh next
+// to the soup. nv = max(3, round(sqrt(count / 8))) around the tube and
+// nu = max(3, round(count / (2 nv))) around the ring, so 2 nu nv triangles,
+// within 0.1% of `count` from 1M up; count in [18, 2^26].
+Geometry tessellated_surface(std::size_t count);
+
 // Appends a closed box around `geometry` (12 triangles facing inwards),
 // `scale` (> 1) times its largest side and centred on it: the "teapot in a
 // stadium" around any geometry, a scene whose primitives fill a tiny part
