@@ -145,6 +145,12 @@ def report(result):
           f"{'flat' if result['flat'] else 'NOT FLAT'} (tolerance {100 * result['tolerance']:.1f}%)")
 
 
+def fail(message):
+    """A phase that could not run or failed: exit status 2."""
+    print(f"soak.py: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
 def positive_count(text):
     value = float(text)
     if value < 1 or value != int(value):
@@ -180,7 +186,7 @@ def main():
     bench = os.path.join(args.build, "bench", "rtcl_billion_rays_bench")
     for phase, binary in (("render", rtcl), ("rays", bench)):
         if phase in phases and not os.access(binary, os.X_OK):
-            sys.exit(f"soak.py: --build {args.build}: no {binary} (build the targets rtcl and rtcl_billion_rays_bench)")
+            fail(f"--build {args.build}: no {binary} (build the targets rtcl and rtcl_billion_rays_bench)")
     print(f"soak: output in {out}; scenes from {env['RTCL_SCENES_DIR']}", flush=True)
 
     results = []
@@ -200,7 +206,7 @@ def main():
         if rc != 0 or len(device) != args.frames:
             with open(log_path) as log:
                 print(log.read()[-3000:])
-            sys.exit(f"soak.py: the render phase failed (exit status {rc}, {len(device)} of {args.frames} frames)")
+            fail(f"the render phase failed (exit status {rc}, {len(device)} of {args.frames} frames)")
         result = verdict("render", samples, int(device[args.warmup_frames - 1]), int(device[-1]), args.tolerance)
         result.update({"frames": args.frames, "seconds": round(seconds, 1), "command": " ".join(cmd)})
         results.append(result)
@@ -218,7 +224,7 @@ def main():
         if rc not in (0, 3):  # 3: the bench's own verdict, memory not flat (judged here as well)
             with open(log_path) as log:
                 print(log.read()[-3000:])
-            sys.exit(f"soak.py: the rays phase failed (exit status {rc})")
+            fail(f"the rays phase failed (exit status {rc})")
         with open(json_path) as lines:
             records = [json.loads(line) for line in lines if line.strip()]
         rows = [b for b in records if not b.get("summary")]
