@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -76,6 +77,57 @@ TEST(DeviceLimits, GlobalMemoryCountsLiveBuffers) {
                  "of " + device.info().name + " (1000000 bytes)");
   }
   EXPECT_EQ(error_of([&] { device.allocate(600000, "after release"); }), "") << "the first buffer was released";
+}
+
+// Device::allocated_bytes: the live buffers allocated through a device and
+// its copies, each gone from the count once released.
+TEST(DeviceLimits, AllocatedBytesCountLiveBuffers) {
+  Device device = Device::open();
+  EXPECT_EQ(device.allocated_bytes(), 0u) << "a device just opened holds no buffer";
+  {
+    cl::Buffer first = device.allocate(600000, "first");
+    const Device copy = device;
+    const std::vector<unsigned char> data(1000, 7);
+    cl::Buffer second = copy.upload(data.data(), data.size(), "second");
+    EXPECT_EQ(device.allocated_bytes(), 601000u);
+    EXPECT_EQ(copy.allocated_bytes(), 601000u) << "copies share one count";
+  }
+  EXPECT_EQ(device.allocated_bytes(), 0u) << "both buffers were released";
+}
+
+// Repeated queries on host arrays hold no more device buffers after their
+// first call than after it (the first call of a kind may keep buffers for
+// the next: the ray sort's), in both host-array ways and over several
+// batches (a 64 KiB largest buffer: 2048 rays a batch); a structure's
+// buffers leave with it.
+TEST(DeviceLimits, HostArrayQueriesLeaveNoDeviceBuffersBehind) {
+  for (const bool copy : {false, true}) {
+    SCOPED_TRACE(copy ? "RTCL_HOST_ARRAYS=copy" : "host arrays shared on CPU devices");
+    ScopedEnv host_arrays("RTCL_HOST_ARRAYS", copy ? std::optional<std::string>("copy") : std::nullopt);
+    ScopedEnv alloc("RTCL_MAX_ALLOC_BYTES", "65536");
+    Device device = Device::open();
+    Geometry soup = random_soup(100, 5);
+    std::vector<Ray> rays = random_rays(soup, 5000, 9);
+    std::vector<glm::vec3> points;
+    for (const Ray& r : rays) points.emplace_back(r.ox, r.oy, r.oz);
+    {
+      auto bvh = make_accel(device, "bvh", soup);
+      EXPECT_GE(device.allocated_bytes(), bvh->stats().device_bytes) << "the structure is on the device";
+      std::vector<Hit> hits(rays.size());
+      auto calls = [&] {
+        for (Coherence coherence : {Coherence::incoherent, Coherence::coherent, Coherence::scattered})
+          for (Query query : {Query::closest, Query::any}) bvh->trace(query, rays, hits, coherence);
+        bvh->count(rays);
+        bvh->all_hits(rays, 4);
+        bvh->closest_points(points);
+      };
+      calls();
+      const std::size_t after_first = device.allocated_bytes();
+      for (int i = 0; i < 5; ++i) calls();
+      EXPECT_EQ(device.allocated_bytes(), after_first);
+    }
+    EXPECT_EQ(device.allocated_bytes(), 0u) << "the structure's buffers left with it";
+  }
 }
 
 TEST(DeviceLimits, OutOfMemoryCodesSayWhatToDo) {

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -181,6 +182,32 @@ TEST(RenderInstances, FramesReplaceOnlyMovingObjectsAndMatchSingleFrames) {
   // The flat path has no re-placing.
   Renderer flat(test_device(), unshare_meshes(scene), "bvh");
   EXPECT_NE(error_of([&] { flat.set_shutter(1.0f, 2.0f); }).find("flat path"), std::string::npos);
+}
+
+// A long animation on one renderer holds no more device buffers as it goes:
+// re-placing the moving objects replaces the top level, it does not add one
+// per frame. A buffer may grow to a larger placement's needs and stay (a
+// few steps); a leak grows at every frame.
+TEST(RenderInstances, FramesHoldNoMoreDeviceBuffersAsTheAnimationGoesOn) {
+  SceneDescription scene = SceneFiles().load(true);
+  RenderSettings settings = small_settings();
+  settings.width = 16;
+  settings.height = 12;
+  Device device = Device::open();  // its own count of live buffers
+  Renderer animated(device, scene, "bvh");
+  ASSERT_TRUE(animated.instanced());
+  std::vector<std::size_t> bytes;
+  for (int frame = 0; frame < 40; ++frame) {
+    const float open = static_cast<float>(scene.camera.shutter_open + frame * 0.25);
+    if (frame > 0) animated.set_shutter(open, open + 0.25f);
+    animated.render(settings);
+    bytes.push_back(device.allocated_bytes());
+  }
+  std::size_t growths = 0;
+  for (std::size_t f = 2; f < bytes.size(); ++f) growths += bytes[f] > bytes[f - 1] ? 1 : 0;
+  EXPECT_LE(growths, 4u) << "device buffers grew in " << growths << " of the frames after the second";
+  EXPECT_LE(static_cast<double>(bytes.back()), 1.05 * static_cast<double>(bytes[1]))
+      << "after 40 frames against after the second";
 }
 
 // An emitting mesh placed twice lights the scene twice: the emissive

@@ -70,6 +70,16 @@ class Device {
   cl::Buffer upload(const void* data, std::size_t bytes, const char* what) const;
   cl::Buffer allocate(std::size_t bytes, const char* what, cl_mem_flags flags = CL_MEM_READ_WRITE) const;
 
+  // Bytes of the device buffers allocated through this Device (and its
+  // copies) that are still alive: structures, scenes, renderers, ray sorts
+  // and the batch buffers of host-array calls in flight; what check_fits
+  // counts as already held. Not counted: buffers the caller creates itself,
+  // and the buffers on the caller's own arrays through which host-array calls
+  // run on CPU devices (host memory). A released buffer leaves the count when
+  // the driver runs its destructor callback (PoCL: during the release; some
+  // drivers a little later).
+  std::size_t allocated_bytes() const;
+
   struct State;
 
  private:

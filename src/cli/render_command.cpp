@@ -160,6 +160,9 @@ void run(const RenderOptions& o) {
     RenderOptions unit_options = o;
     unit_options.output = unit.output;
     print_render_summary(unit_options, unit_plan, device.info().name, renderer->stats(), renderer->defines());
+    if (o.verbose)
+      std::printf("rtcl render: %s: %.2f MiB of device buffers held\n", unit.output.c_str(),
+                  device.allocated_bytes() / 1048576.0);
   }
 }
 

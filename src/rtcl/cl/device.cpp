@@ -229,6 +229,8 @@ cl::Buffer Device::allocate(std::size_t bytes, const char* what, cl_mem_flags fl
   });
 }
 
+std::size_t Device::allocated_bytes() const { return *state_->live_bytes; }
+
 cl::Buffer Device::upload(const void* data, std::size_t bytes, const char* what) const {
   cl::Buffer buffer = allocate(bytes, what, CL_MEM_READ_ONLY);
   if (bytes > 0)
