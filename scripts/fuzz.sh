@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (fuzz/, clang + ASan + UBSan) in build-fuzz/
-# and runs each for a bounded time. A crash, a leak, a hang (one input over
-# 10 s) or an allocation beyond the rss limit fails the run; the failing
-# input is saved under build-fuzz/artifacts/<target>/ and must then be added
-# to tests/fuzz_regressions/<target>/ (replayed by ctest) and fixed.
+# Builds the libFuzzer targets (fuzz/: clang, the library's sources with the
+# fuzzer's instrumentation, ASan and UBSan) in build-fuzz/ and runs each for
+# a bounded time. A crash, a leak, a hang (one input over 10 s), an
+# allocation beyond the rss limit or (structures) a wrong answer fails the
+# run; the failing input is saved under build-fuzz/artifacts/<target>/ and
+# must then be added to tests/fuzz_regressions/<target>/ (replayed by ctest)
+# and fixed.
 #
 #   bash scripts/fuzz.sh --ci                      # every target, 30 s each (CI)
 #   bash scripts/fuzz.sh --seconds 3600 --jobs 2   # a longer campaign
-#   bash scripts/fuzz.sh --seconds 600 mesh_loader # one target
+#   bash scripts/fuzz.sh --seconds 600 structures  # one target
 #
 # The corpus grown by a run is kept in build-fuzz/corpus/<target>/ and reused
 # by the next run; the seeds in fuzz/corpus/<target>/ are never written.
@@ -28,12 +30,15 @@ while [ $# -gt 0 ]; do
   esac
   shift
 done
-[ ${#targets[@]} -gt 0 ] || targets=(mesh_loader scene_file ray_file)
+[ ${#targets[@]} -gt 0 ] || targets=(mesh_loader scene_file ray_file structures)
 
 bash scripts/setup.sh
-[ -f build/librtcl.so ] || bash scripts/build.sh  # the fuzz targets link it for the structures' declarations
-cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DRTCL_LIBRARY="$PWD/build/librtcl.so" >/dev/null
+cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ >/dev/null
 cmake --build build-fuzz -j "$(nproc)"
+# The structures target builds every kernel program before its first input
+# (LLVMFuzzerInitialize); PoCL keeps them here for the next run.
+export POCL_CACHE_DIR="$PWD/build-fuzz/pocl-cache"
+mkdir -p "$POCL_CACHE_DIR"
 
 # Leaks fail the run (libFuzzer's -detect_leaks); allocations above
 # -rss_limit_mb / -malloc_limit_mb are reported as out-of-memory.
