@@ -10,13 +10,14 @@
 // strips sharing edges, scaled by 2^-20 .. 2^20 and translated by up to
 // 2^11 lattice units (the lattice spans 32) from the origin: farther, the
 // judge's tolerance, which grows with the coordinates' magnitude, would
-// exceed the triangles. The rays (up to 64): aimed at vertices, edge
-// points, interior points, sphere silhouettes or anywhere in the box; axis-
-// parallel with +0 / -0 components, along a triangle's normal, lying in its
-// plane along an edge, or any direction; starting on their target or away
-// from it, with [tmin, tmax] ending at or starting from the target.
+// exceed the triangles. The rays (up to 64, then repeated to 64): aimed at
+// vertices, edge points, interior points, sphere silhouettes or anywhere in
+// the box; axis-parallel with +0 / -0 components, along a triangle's normal,
+// lying in its plane along an edge, or any direction; starting on their
+// target or away from it, with [tmin, tmax] ending at or starting from the
+// target.
 //
-// What is checked (docs/robustness.md, "Fuzzing"), on every call (closest
+// What is checked (docs/robustness.md, "The structures target"), on every call (closest
 // and any hit; the coherent kernel where it differs; the sorted kernel at
 // robust where the structure sorts):
 // - robust and exact, no leak: a ray whose reference hit (reference.hpp:
@@ -281,6 +282,10 @@ std::vector<Ray> make_rays(Bytes& in, const Scene& s) {
     }
     rays.push_back(ray);
   }
+  // Always kMaxRays rays (the decoded ones repeated): PoCL specialises a
+  // kernel for each work-group size it picks for a launch's size, so that
+  // launches of one size compile once (LLVMFuzzerInitialize).
+  for (std::size_t i = 0; rays.size() < kMaxRays; ++i) rays.push_back(rays[i]);
   return rays;
 }
 
@@ -479,7 +484,7 @@ void build_programs() {
   g.source = "fuzz warm-up";
   g.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 1}};
   g.triangles = {{0, 1, 2}, {1, 3, 2}};
-  std::vector<Ray> rays(8, Ray{0.2f, 0.2f, 1.0f, 0.0f, 0.0f, -1.0f, 0.0f, kInf});
+  std::vector<Ray> rays(kMaxRays, Ray{0.2f, 0.2f, 1.0f, 0.0f, 0.0f, -1.0f, 0.0f, kInf});
   for (bool with_spheres : {false, true}) {
     if (with_spheres) g.spheres = {{{0.5f, 0.5f, 0.5f}, 0.25f}};
     for (Precision level : levels())
