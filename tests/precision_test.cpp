@@ -32,50 +32,6 @@ constexpr float kNaN = everywhere::kNaN;
 // ---------------------------------------------------------------------------
 // The exact level against the double reference.
 
-// The closest primitive by the double reference, or -2 when double precision
-// itself cannot tell (the hit within 1e-9 of the scene's size of a boundary,
-// or another candidate within 1e-9 relative in t): where the exact level
-// must agree, which is far closer to the boundaries than the float
-// tolerance of the robust judge (256 float ulps, ~3e-5).
-struct DoubleAnswer {
-  int prim = -1;
-  double t = 0.0;
-};
-
-DoubleAnswer double_closest(const Geometry& g, const Ray& ray, double scene_size) {
-  const double space = 1e-9 * scene_size;
-  const Tolerance tolerance = tolerance_for(g, ray);
-  DoubleAnswer best;
-  double best_t = INFINITY;
-  bool ambiguous = false;
-  std::vector<std::pair<double, std::uint32_t>> near;  // candidates within `space` of their boundary
-  for (std::uint32_t p = 0; p < g.primitive_count(); ++p) {
-    if (p < g.triangles.size() && zero_area(g, p)) continue;
-    PrimHit h = reference_intersect(g, p, ray, tolerance);
-    if (!h.plane || h.margin < -space) continue;
-    if (h.t < ray.tmin || h.t > ray.tmax) continue;
-    if (h.margin <= space) {
-      near.push_back({h.t, p});
-      continue;
-    }
-    if (h.t < best_t) {
-      best_t = h.t;
-      best.prim = static_cast<int>(p);
-    }
-  }
-  best.t = best_t;
-  for (auto [t, p] : near)
-    if (t <= best_t * (1.0 + 1e-9)) ambiguous = true;
-  if (best.prim >= 0)
-    for (std::uint32_t p = 0; p < g.primitive_count(); ++p) {
-      if (static_cast<int>(p) == best.prim || (p < g.triangles.size() && zero_area(g, p))) continue;
-      PrimHit h = reference_intersect(g, p, ray, tolerance);
-      if (h.plane && h.margin > space && std::abs(h.t - best_t) <= 1e-9 * std::abs(best_t)) ambiguous = true;
-    }
-  if (ambiguous) best.prim = -2;
-  return best;
-}
-
 // Rays aimed at points just inside and just outside triangle edges (1e-6 to
 // 1e-8 of the edge's length: beyond what float decides reliably, well
 // within what double decides), plus random rays.

@@ -250,6 +250,48 @@ std::vector<std::string> judge_all(const Geometry& g, const std::vector<Ray>& ra
   return judge_rays(g, rays, hits, query, &references, failures, report);
 }
 
+DoubleAnswer double_closest(const Geometry& g, const Ray& ray, double scene_size) {
+  const Tolerance tolerance = tolerance_for(g, ray);
+  // Double precision decides far closer than `space` to a boundary: its
+  // rounding error is ~1e-16 of the coordinates' magnitude (the scene's and
+  // the origin's, tolerance_for's), kept below by 1e-12 of it.
+  const double magnitude = tolerance.space / (256.0 * FLT_EPSILON);
+  const double space = std::max(1e-9 * scene_size, 1e-12 * magnitude);
+  const double slack = space / glm::length(direction(ray));  // the same in t
+  // A sphere's near root counts from tmin - slack (else its far root): an
+  // origin just inside a sphere meets its far root, which double decides.
+  const Tolerance roots{space, slack};
+  DoubleAnswer best;
+  double best_t = kInf;
+  bool ambiguous = false;
+  std::vector<double> near;  // t of candidates within `space` of their boundary, or `slack` of tmin or tmax
+  for (std::uint32_t p = 0; p < g.primitive_count(); ++p) {
+    if (p < g.triangles.size() && zero_area(g, p)) continue;
+    PrimHit h = reference_intersect(g, p, ray, roots);
+    if (!h.plane || h.margin < -space) continue;
+    if (h.t < ray.tmin - slack || h.t > ray.tmax + slack) continue;
+    if (h.margin <= space || h.t <= ray.tmin + slack || h.t >= ray.tmax - slack) {
+      near.push_back(h.t);
+      continue;
+    }
+    if (h.t < best_t) {
+      best_t = h.t;
+      best.prim = static_cast<int>(p);
+    }
+  }
+  best.t = best_t;
+  for (double t : near)
+    if (t <= best_t + slack) ambiguous = true;
+  if (best.prim >= 0)
+    for (std::uint32_t p = 0; p < g.primitive_count(); ++p) {
+      if (static_cast<int>(p) == best.prim || (p < g.triangles.size() && zero_area(g, p))) continue;
+      PrimHit h = reference_intersect(g, p, ray, roots);
+      if (h.plane && h.margin > space && std::abs(h.t - best_t) <= slack) ambiguous = true;
+    }
+  if (ambiguous) best.prim = -2;
+  return best;
+}
+
 AnswerErrors answer_errors(const Geometry& g, const std::vector<Ray>& rays, const std::vector<Hit>& hits, Query query,
                            const std::vector<Hit>& references) {
   if (references.size() != rays.size() || hits.size() != rays.size())

@@ -61,6 +61,20 @@ std::vector<std::string> judge_all(const Geometry& geometry, const std::vector<R
                                    const std::vector<Hit>& hits, Query query, const std::vector<Hit>& references,
                                    std::size_t* failures, std::size_t report = 5);
 
+// The closest primitive by the double reference, or prim = -2 when double
+// precision itself cannot tell: the hit, or another candidate as near in t,
+// lies within 1e-9 of scene_size (at least 1e-12 of the coordinates'
+// magnitude, tolerance_for's) of a primitive's boundary, or as near (over
+// |d|) in t to tmin, tmax or the other's t. That is where the exact level
+// must agree (docs/precision.md), far closer to the boundaries than the
+// robust judge's tolerance (256 float ulps, ~3e-5). prim = -1 (t = +inf):
+// double precision decides that the ray misses.
+struct DoubleAnswer {
+  int prim = -1;
+  double t = 0.0;
+};
+DoubleAnswer double_closest(const Geometry& geometry, const Ray& ray, double scene_size);
+
 // How far answers stray from the reference, for a level without the
 // judge's guarantee (fast), against references[i] == reference_closest(
 // geometry, rays[i]).

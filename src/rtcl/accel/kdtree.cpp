@@ -373,7 +373,11 @@ class ExactBuilder {
     }
     below_new = {};
     above_new = {};
-    const auto [below_path, above_path] = child_paths(path, split, leaf_cost);
+    // Not a structured binding: the lambda below uses both, and clang before
+    // 16 cannot capture one (the fuzz targets build this file with clang).
+    const std::array<KdPath, 2> paths = child_paths(path, split, leaf_cost);
+    const KdPath& below_path = paths[0];
+    const KdPath& above_path = paths[1];
     node.below = std::make_unique<KdBuildNode>();
     node.above = std::make_unique<KdBuildNode>();
     if (n >= kExactParallelMin && threads_.try_take()) {
