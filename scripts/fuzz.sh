@@ -36,8 +36,10 @@ bash scripts/setup.sh
 cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ >/dev/null
 cmake --build build-fuzz -j "$(nproc)"
 # The structures target builds every kernel program before its first input
-# (LLVMFuzzerInitialize); PoCL keeps them here for the next run.
-export POCL_CACHE_DIR="$PWD/build-fuzz/pocl-cache"
+# (LLVMFuzzerInitialize). PoCL's kernel cache is the test suite's: the
+# kernels do not depend on the host build, so after scripts/test.sh (as in
+# CI) the programs are already compiled.
+export POCL_CACHE_DIR="${POCL_CACHE_DIR:-$PWD/build/pocl-cache}"
 mkdir -p "$POCL_CACHE_DIR"
 
 # Leaks fail the run (libFuzzer's -detect_leaks); allocations above
