@@ -374,6 +374,31 @@ std::string judge(const Geometry& g, const rtcl::Aabb& bounds, const Ray& ray, c
   return "";
 }
 
+// The input being checked, and where a failing one is written (libFuzzer's
+// -artifact_prefix, else the working directory): the target writes it
+// itself before aborting, so that a violation is kept even where the
+// process dies before libFuzzer's crash handler runs.
+struct CurrentInput {
+  const std::uint8_t* data = nullptr;
+  std::size_t size = 0;
+  std::string prefix;
+} current;
+
+// Writes the current input to <prefix>violation-<FNV-1a hash>, returns its path.
+std::string save_current_input() {
+  std::uint64_t hash = 1469598103934665603ull;
+  for (std::size_t i = 0; i < current.size; ++i) hash = (hash ^ current.data[i]) * 1099511628211ull;
+  char name[40];
+  std::snprintf(name, sizeof name, "violation-%016llx", static_cast<unsigned long long>(hash));
+  std::string path = current.prefix + name;
+  if (std::FILE* f = std::fopen(path.c_str(), "wb")) {
+    bool ok = std::fwrite(current.data, 1, current.size, f) == current.size;
+    ok = std::fclose(f) == 0 && ok;
+    if (ok) return path;
+  }
+  return "(not written: " + path + ")";
+}
+
 // What one call and one ray looked like, for the failure message.
 [[noreturn]] void fail(const std::string& structure, Precision level, Coherence coherence, Query query,
                        std::size_t index, const Ray& ray, const std::string& why) {
@@ -385,6 +410,7 @@ std::string judge(const Geometry& g, const rtcl::Aabb& bounds, const Ray& ray, c
                structure.c_str(), std::string(rtcl::precision_name(level)).c_str(), order,
                query == Query::closest ? "closest" : "any", index, ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz,
                ray.tmin, ray.tmax, why.c_str());
+  std::fprintf(stderr, "structures_fuzz: the input is saved as %s\n", save_current_input().c_str());
   std::abort();
 }
 
@@ -497,12 +523,17 @@ void build_programs() {
 
 }  // namespace
 
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
+extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
+  const std::string flag = "-artifact_prefix=";
+  for (int i = 1; i < *argc; ++i)
+    if (std::string arg = (*argv)[i]; arg.compare(0, flag.size(), flag) == 0) current.prefix = arg.substr(flag.size());
   build_programs();
   return 0;
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  current.data = data;
+  current.size = size;
   Bytes in(data, size);
   Scene scene = make_scene(in);
   if (scene.geometry.triangles.empty() && scene.geometry.spheres.empty()) return 0;

@@ -176,6 +176,7 @@ TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
   for (int i = 0; i < 100; ++i) g.spheres.push_back({{unit(rng), unit(rng), unit(rng)}, 0.005f + 0.03f * unit(rng)});
   std::vector<Ray> rays;
+  std::vector<char> at_vertex;  // per ray: aimed exactly at a mesh vertex
   for (int p = 0; p < 240; ++p) {
     glm::vec3 sign(unit(rng) < 0.5f ? -1.0f : 1.0f, unit(rng) < 0.5f ? -1.0f : 1.0f, unit(rng) < 0.5f ? -1.0f : 1.0f);
     float spread = p % 3 == 0 ? 1.0f : p % 3 == 1 ? 0.05f : 0.0f;  // origins: whole scene, a patch, one point
@@ -191,6 +192,7 @@ TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
         o = centre - 1.5f * sign + spread * glm::vec3(unit(rng) - 0.5f, unit(rng) - 0.5f, unit(rng) - 0.5f);
       }
       rays.push_back({o.x, o.y, o.z, d.x, d.y, d.z, 0.0f, kInf});
+      at_vertex.push_back(p % 4 == 3);
     }
   }
   for (int p = 0; p < 60; ++p) {  // one origin each (tight frusta): aimed at vertices, or from inside with tmin < 0
@@ -202,12 +204,14 @@ TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
       glm::vec3 v = g.vertices[static_cast<std::size_t>(unit(rng) * static_cast<float>(g.vertices.size() - 1))];
       glm::vec3 d = behind ? sign * glm::vec3(0.05f + unit(rng), 0.05f + unit(rng), 0.05f + unit(rng)) : v - o;
       rays.push_back({o.x, o.y, o.z, d.x, d.y, d.z, behind ? -0.5f : 0.0f, kInf});
+      at_vertex.push_back(!behind);
     }
   }
   rays[8 * 5 + 3].dx = kNaN;  // inactive lane in a frustum packet
   for (int l = 0; l < 8; ++l) {  // axis-parallel rays (infinite reciprocals): not a frustum
     float y = 0.1f + 0.1f * static_cast<float>(l);
     rays.push_back({-1.0f, y, 0.5f, 1.0f, 0.0f, 0.0f, 0.0f, kInf});
+    at_vertex.push_back(false);
   }
   rays.resize(rays.size() - 3);  // a partial last packet
   for (Precision level : {Precision::fast, Precision::robust, Precision::exact}) {
@@ -215,15 +219,23 @@ TEST(BvhPacket, FrustumPacketsMatchSingleRaysAndReference) {
     auto packet = make_accel(test_device(), "bvh-packet", g, {level});
     auto single = make_accel(test_device(), "bvh", g, {level});
     if (level == Precision::fast) {
-      // not watertight: the same answers as the single-ray kernel, t to rounding
+      // not watertight: the same answers as the single-ray kernel, t to
+      // rounding, except on rays aimed exactly at a vertex, which either
+      // kernel may count as a hit or a miss (Moller-Trumbore under
+      // -cl-fast-relaxed-math rounds each kernel's edge tests its own way:
+      // a ray differs on some CPUs)
       for (Query q : {Query::closest, Query::any}) {
         auto expected = run_query(*single, rays, q);
         auto got = run_query(*packet, rays, q);
+        std::size_t compared = 0;
         for (std::size_t i = 0; i < rays.size(); ++i) {
+          if (at_vertex[i] && (got[i].prim >= 0) != (expected[i].prim >= 0)) continue;
+          ++compared;
           ASSERT_EQ(got[i].prim >= 0, expected[i].prim >= 0) << "ray " << i;
           if (q == Query::closest && got[i].prim >= 0)
             EXPECT_NEAR(got[i].t, expected[i].t, 1e-5f * std::abs(expected[i].t)) << "ray " << i;
         }
+        EXPECT_GE(compared, rays.size() - rays.size() / 100) << "rays aimed at vertices that the kernels decide apart";
       }
       continue;
     }

@@ -11,20 +11,34 @@
 #include "shared/exact.h"
 
 /* The ray/sphere quadratic, every argument per lane (a single-ray caller
- * broadcasts its ray, a packet caller its sphere): f = o - c, a = d.d,
- * b = -f.d (= a * t of the closest approach), the squared distance l2 of
+ * broadcasts its ray, a packet caller its sphere), on the direction scaled
+ * by a power of two, d' = d * scale with scale = 2^-e for the exponent e of
+ * the largest |d| component (clamped to [-126, 126]): exact, and it keeps
+ * a = d'.d' and the discriminant clear of float underflow and overflow for
+ * very short or very long directions (a direction 1e-18 long put a root's
+ * point 14 tolerances off the sphere); the roots of d' are those of d over
+ * scale (t = t' * scale, rtcl_sphere_roots8). f = o - c, a = d'.d',
+ * b = -f.d' (= a * t' of the closest approach), the squared distance l2 of
  * the line from the centre, and the discriminant a (r^2 - l2), which does
  * not cancel for distant spheres (Haines et al., Ray Tracing Gems ch. 7).
  * *cand (exact level): the lanes whose discriminant is real or within
  * rounding of zero, which double precision then decides. The one source
  * of this arithmetic. */
 typedef struct SphereQuadratic8 {
-  float8 fx, fy, fz, a, b, l2, disc;
+  float8 fx, fy, fz, a, b, l2, disc, scale;
 } SphereQuadratic8;
 
 RTCL_LANES_INLINE SphereQuadratic8 rtcl_sphere_quadratic8(float8 cx, float8 cy, float8 cz, float8 r, float8 ox,
                                                           float8 oy, float8 oz, float8 dx, float8 dy, float8 dz) {
   SphereQuadratic8 q;
+  /* e from the exponent bits of max |d| (a subnormal's are 0: e = -127,
+   * clamped) */
+  float8 largest = fmax(fabs(dx), fmax(fabs(dy), fabs(dz)));
+  int8 e = clamp(((as_int8(largest) >> 23) & 0xff) - 127, (int8)(-126), (int8)(126));
+  q.scale = as_float8((127 - e) << 23);
+  dx *= q.scale;
+  dy *= q.scale;
+  dz *= q.scale;
   q.fx = ox - cx;
   q.fy = oy - cy;
   q.fz = oz - cz;
@@ -43,14 +57,14 @@ RTCL_LANES_INLINE int8 rtcl_sphere_candidates8(const SphereQuadratic8* q, float8
                         (r * r + q->l2 + q->fx * q->fx + q->fy * q->fy + q->fz * q->fz);
 }
 #else
-/* The two roots (*tn <= *tf, from the numerically stable pair c / q, q / a)
- * and which of them lie in [tmin, t_best). */
+/* The two roots for d (*tn <= *tf, from the numerically stable pair c / q,
+ * q / a, times scale) and which of them lie in [tmin, t_best). */
 RTCL_LANES_INLINE void rtcl_sphere_roots8(const SphereQuadratic8* q, float8 r, float8 tmin, float8 t_best,
                                           float8* tn, float8* tf, int8* ok_n, int8* ok_f) {
   int8 real = q->disc >= 0.0f;
   float8 c = q->fx * q->fx + q->fy * q->fy + q->fz * q->fz - r * r;
   float8 qq = q->b + copysign(sqrt(fmax(q->disc, 0.0f)), q->b);
-  float8 t0 = c / qq, t1 = qq / q->a;
+  float8 t0 = c / qq * q->scale, t1 = qq / q->a * q->scale;
   *tn = fmin(t0, t1);
   *tf = fmax(t0, t1);
   *ok_n = real & (*tn >= tmin) & (*tn < t_best);

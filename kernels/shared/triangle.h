@@ -93,16 +93,68 @@ RTCL_LANES_INLINE int8 rtcl_watertight_inside8(const Watertight8* w) {
   return (rtcl_fmin8(w->U, rtcl_fmin8(w->V, w->W)) >= 0.0f) | (rtcl_fmax8(w->U, rtcl_fmax8(w->V, w->W)) <= 0.0f);
 }
 
+#if defined(RTCL_HAS_FP64) && defined(RTCL_PRECISION_ROBUST)
+/* One double4 half of rtcl_watertight_refine8: U, V, W, det and t
+ * recomputed in double from the sheared float vertices (each product of two
+ * floats is exact in double) where `redo` is set. */
+inline void rtcl_watertight_refine4(double4 Ax, double4 Ay, double4 Az, double4 Bx, double4 By, double4 Bz,
+                                    double4 Cx, double4 Cy, double4 Cz, double4 sz, long4 redo, float4* U,
+                                    float4* V, float4* W, float4* det, float4* t) {
+  double4 u = Cx * By - Cy * Bx, v = Ax * Cy - Ay * Cx, w = Bx * Ay - By * Ax;
+  double4 d = u + v + w;
+  double4 T = sz * (u * Az + v * Bz + w * Cz);
+  int4 r = convert_int4(redo);
+  *U = select(*U, convert_float4(u), r);
+  *V = select(*V, convert_float4(v), r);
+  *W = select(*W, convert_float4(w), r);
+  *det = select(*det, convert_float4(d), r);
+  *t = select(*t, convert_float4(T / d), r);
+}
+
+/* The lanes inside their edges whose float determinant is ill-conditioned
+ * (|det| below 2^-5 of the sum of the edge functions' absolute products,
+ * whose float rounding reaches 2^-23 of that sum: a thin sliver, or a
+ * triangle seen almost edge-on) get U, V, W, det and t from double:
+ * otherwise t = T / det can be wrong by far more than the float rounding
+ * of the hit point (a sliver 1e5 long and 0.03 wide, hit head-on, put the
+ * point 7e3 off the triangle). The inside decision stays the float one, so
+ * shared edges stay watertight; only lanes that are inside pay. */
+RTCL_LANES_INLINE void rtcl_watertight_refine8(Watertight8* w, float8 sz, int8 inside, float8* det, float8* t) {
+  if (!rtcl_any8(inside)) return;
+  float8 products = fabs(w->Cx * w->By) + fabs(w->Cy * w->Bx) + fabs(w->Ax * w->Cy) + fabs(w->Ay * w->Cx) +
+                    fabs(w->Bx * w->Ay) + fabs(w->By * w->Ax);
+  int8 redo = inside & (fabs(*det) < products * 0x1p-5f);
+  if (!rtcl_any8(redo)) return;
+  float4 U = w->U.lo, V = w->V.lo, W = w->W.lo, d = det->lo, tt = t->lo;
+  rtcl_watertight_refine4(convert_double4(w->Ax.lo), convert_double4(w->Ay.lo), convert_double4(w->Az.lo),
+                          convert_double4(w->Bx.lo), convert_double4(w->By.lo), convert_double4(w->Bz.lo),
+                          convert_double4(w->Cx.lo), convert_double4(w->Cy.lo), convert_double4(w->Cz.lo),
+                          convert_double4(sz.lo), convert_long4(redo.lo), &U, &V, &W, &d, &tt);
+  w->U.lo = U; w->V.lo = V; w->W.lo = W; det->lo = d; t->lo = tt;
+  U = w->U.hi; V = w->V.hi; W = w->W.hi; d = det->hi; tt = t->hi;
+  rtcl_watertight_refine4(convert_double4(w->Ax.hi), convert_double4(w->Ay.hi), convert_double4(w->Az.hi),
+                          convert_double4(w->Bx.hi), convert_double4(w->By.hi), convert_double4(w->Bz.hi),
+                          convert_double4(w->Cx.hi), convert_double4(w->Cy.hi), convert_double4(w->Cz.hi),
+                          convert_double4(sz.hi), convert_long4(redo.hi), &U, &V, &W, &d, &tt);
+  w->U.hi = U; w->V.hi = V; w->W.hi = W; det->hi = d; t->hi = tt;
+}
+#endif
+
 /* The robust level's decision from rtcl_watertight_edges8: the lanes hit
  * in [tmin, t_best) (inside all three edges, either winding; not in the
  * triangle's plane), with the hit distance *t and the determinant *det
- * (barycentrics V / det, W / det). */
-RTCL_LANES_INLINE int8 rtcl_watertight_hit8(const Watertight8* w, float8 sz, float8 tmin, float8 t_best,
-                                            float8* t, float8* det) {
+ * (barycentrics V / det, W / det; at the robust level with fp64, lanes with
+ * an ill-conditioned det have U, V, W, det and t from double,
+ * rtcl_watertight_refine8). */
+RTCL_LANES_INLINE int8 rtcl_watertight_hit8(Watertight8* w, float8 sz, float8 tmin, float8 t_best, float8* t,
+                                            float8* det) {
   int8 inside = rtcl_watertight_inside8(w);
   *det = w->U + w->V + w->W;
   float8 T = sz * (w->U * w->Az + w->V * w->Bz + w->W * w->Cz);
   *t = T / *det;
+#if defined(RTCL_HAS_FP64) && defined(RTCL_PRECISION_ROBUST)
+  rtcl_watertight_refine8(w, sz, inside & (*det != 0.0f), det, t);
+#endif
   return inside & (*det != 0.0f) & (*t >= tmin) & (*t < t_best);
 }
 
@@ -131,7 +183,7 @@ RTCL_LANES_INLINE int8 rtcl_edge_owned8(float8 dx, float8 dy) {
   return (dy > 0.0f) | ((dy == 0.0f) & (dx > 0.0f));
 }
 
-RTCL_LANES_INLINE int8 rtcl_crossing_hit8(const Watertight8* w, float8 sz, float8 tmin, float8 tmax, float8* t,
+RTCL_LANES_INLINE int8 rtcl_crossing_hit8(Watertight8* w, float8 sz, float8 tmin, float8 tmax, float8* t,
                                           float8* det) {
   /* U, V, W = minus the orientation of the origin against B->C, C->A,
    * A->B: where all are >= 0 the interior lies right of these directions,
@@ -148,6 +200,9 @@ RTCL_LANES_INLINE int8 rtcl_crossing_hit8(const Watertight8* w, float8 sz, float
   *det = w->U + w->V + w->W;
   float8 T = sz * (w->U * w->Az + w->V * w->Bz + w->W * w->Cz);
   *t = T / *det;
+#if defined(RTCL_HAS_FP64) && defined(RTCL_PRECISION_ROBUST)
+  rtcl_watertight_refine8(w, sz, (pos | neg) & (*det != 0.0f), det, t);
+#endif
   return (pos | neg) & (*det != 0.0f) & (*t >= tmin) & (*t <= tmax);
 }
 #endif
