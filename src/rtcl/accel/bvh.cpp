@@ -68,10 +68,31 @@ BuildTree build_kind(std::span<const Aabb> bounds, std::span<const std::uint32_t
   return config.builder == BvhBuilder::ploc ? build_ploc(bounds, ids, config.ploc) : build_sah(bounds, ids, config.sah);
 }
 
+// The host image's nodes on the device; with `release`, the host nodes are
+// freed once uploaded.
+cl::Buffer upload_nodes(const Device& device, const Bvh8& bvh, Bvh8* release) {
+  cl::Buffer nodes = device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes");
+  if (release) std::vector<Bvh8Node>().swap(release->nodes);
+  return nodes;
+}
+
+// The host image's blocks on the device; with `release`, the host blocks are
+// freed once uploaded.
+DevicePrimitives upload_blocks(const Device& device, const Bvh8& bvh, Bvh8* release) {
+  DevicePrimitives primitives = upload(device, bvh.blocks);
+  if (release) release->blocks = PrimitiveBlocks{};
+  return primitives;
+}
+
 class BvhAccel final : public Accel {
  public:
+  // Over the host image `bvh`. `release` is null or `bvh` itself, which the
+  // caller gives up: each of its arrays is then freed as soon as it is on
+  // the device, so that the build's peak memory holds one array's device
+  // copy beside the host image, not a device copy of all of it (the refit
+  // tables are made from the image first).
   BvhAccel(const Device& device, std::string name, const BvhConfig& bvh_config, std::vector<std::string> defines,
-           const Bvh8& bvh, const Geometry& geometry, AccelStats stats, const AccelConfig& config)
+           const Bvh8& bvh, Bvh8* release, const Geometry& geometry, AccelStats stats, const AccelConfig& config)
       : Accel(device, std::move(name),
               bvh_config.traversal == BvhTraversal::packet ? packet_kernels(bvh_config, device)
                                                            : single_ray_kernels(bvh_config, device),
@@ -79,9 +100,9 @@ class BvhAccel final : public Accel {
                   ? std::nullopt
                   : std::optional(packet_kernels(bvh_config, device)),
               std::move(defines), stats, config),
-        nodes_(device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes")),
-        primitives_(upload(device, bvh.blocks)),
-        refit_(bvh, geometry) {}
+        refit_(bvh, geometry),
+        nodes_(upload_nodes(device, bvh, release)),
+        primitives_(upload_blocks(device, bvh, release)) {}
 
  private:
   static TraceKernels single_ray_kernels(const BvhConfig& config, const Device& device) {
@@ -102,9 +123,9 @@ class BvhAccel final : public Accel {
     return refit_.run(*this, nodes_, primitives_.triangles, geometry, policy, bounds);
   }
 
+  Bvh8Refit refit_;
   cl::Buffer nodes_;
   DevicePrimitives primitives_;
-  Bvh8Refit refit_;
 };
 
 }  // namespace
@@ -222,13 +243,15 @@ BuiltBvh build_bvh(const Geometry& geometry, const BvhConfig& config) {
 
 std::unique_ptr<Accel> make_bvh_accel(const Device& device, const BuiltBvh& built, const Geometry& geometry,
                                       const BvhConfig& config, std::string name, const AccelConfig& accel_config) {
-  return std::make_unique<BvhAccel>(device, std::move(name), config, built.defines, built.bvh, geometry, built.stats,
-                                    accel_config);
+  return std::make_unique<BvhAccel>(device, std::move(name), config, built.defines, built.bvh, nullptr, geometry,
+                                    built.stats, accel_config);
 }
 
 std::unique_ptr<Accel> make_bvh(const Device& device, const Geometry& geometry, const BvhConfig& config,
                                 std::string name, const AccelConfig& accel_config) {
-  return make_bvh_accel(device, build_bvh(geometry, config), geometry, config, std::move(name), accel_config);
+  BuiltBvh built = build_bvh(geometry, config);
+  return std::make_unique<BvhAccel>(device, std::move(name), config, built.defines, built.bvh, &built.bvh, geometry,
+                                    built.stats, accel_config);
 }
 
 namespace {
