@@ -1,8 +1,10 @@
 // Peak resident memory of this process over a stretch of code, as `rtcl
 // bench` reports it for each build: the kernel's high-water mark (VmHWM)
 // is reset to the current resident size on construction (writing 5 to
-// /proc/self/clear_refs, Linux 4.0+) and peak_extra_bytes() is how far it
-// rose above that size since. On a CPU OpenCL device this includes the
+// /proc/self/clear_refs, Linux 4.0+), after the allocator has returned the
+// free memory it kept (malloc_trim), and peak_extra_bytes() is how far it
+// rose above that size since: the fresh memory the code touched at most at
+// once. On a CPU OpenCL device this includes the
 // structure's device buffers, which live in host memory.
 #pragma once
 
