@@ -374,13 +374,15 @@ std::string judge(const Geometry& g, const rtcl::Aabb& bounds, const Ray& ray, c
   return "";
 }
 
-// The input being checked, and where a failing one is written (libFuzzer's
-// -artifact_prefix, else the working directory): the target writes it
-// itself before aborting, so that a violation is kept even where the
-// process dies before libFuzzer's crash handler runs.
+// The input being checked, and, under libFuzzer (LLVMFuzzerInitialize,
+// which the replay of files does not call), where a failing one is written:
+// libFuzzer's -artifact_prefix, else the working directory. The target
+// writes it itself before aborting, so that a violation is kept even where
+// the process dies before libFuzzer's crash handler runs.
 struct CurrentInput {
   const std::uint8_t* data = nullptr;
   std::size_t size = 0;
+  bool save = false;
   std::string prefix;
 } current;
 
@@ -410,7 +412,7 @@ std::string save_current_input() {
                structure.c_str(), std::string(rtcl::precision_name(level)).c_str(), order,
                query == Query::closest ? "closest" : "any", index, ray.ox, ray.oy, ray.oz, ray.dx, ray.dy, ray.dz,
                ray.tmin, ray.tmax, why.c_str());
-  std::fprintf(stderr, "structures_fuzz: the input is saved as %s\n", save_current_input().c_str());
+  if (current.save) std::fprintf(stderr, "structures_fuzz: the input is saved as %s\n", save_current_input().c_str());
   std::abort();
 }
 
@@ -524,6 +526,7 @@ void build_programs() {
 }  // namespace
 
 extern "C" int LLVMFuzzerInitialize(int* argc, char*** argv) {
+  current.save = true;
   const std::string flag = "-artifact_prefix=";
   for (int i = 1; i < *argc; ++i)
     if (std::string arg = (*argv)[i]; arg.compare(0, flag.size(), flag) == 0) current.prefix = arg.substr(flag.size());

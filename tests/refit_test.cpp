@@ -27,6 +27,7 @@ namespace rtcl::test {
 namespace {
 
 using everywhere::describe;
+using everywhere::disagreements_with_brute;
 using everywhere::expect_at_level;
 using everywhere::make_ray;
 using everywhere::query_name;
@@ -114,15 +115,9 @@ void expect_refit_answers(const Geometry& built, const Geometry& moved, const st
           SCOPED_TRACE(what);
           const std::vector<Hit> hits = run_query(*accel, rays, query, coherence);
           expect_at_level(level, false, what, [&] {
-            std::size_t disagreements = 0, failures = 0;
+            std::size_t failures = 0;
             std::string first;
-            for (std::size_t i = 0; i < rays.size(); ++i) {
-              const bool same = (hits[i].prim < 0) == (expected[i].prim < 0) &&
-                                (query == Query::any || hits[i].prim < 0 || hits[i].t == expected[i].t);
-              if (!same && disagreements++ == 0)
-                first = "ray " + std::to_string(i) + " " + describe(rays[i]) + ": " + describe(hits[i]) +
-                        ", brute force " + describe(expected[i]);
-            }
+            const std::size_t disagreements = disagreements_with_brute(rays, hits, expected, query, &first);
             if (level != Precision::fast)
               EXPECT_EQ(disagreements, 0u) << "of " << rays.size() << " rays; first: " << first;
             auto report = judge_all(moved, rays, hits, query, references, &failures);

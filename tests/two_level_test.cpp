@@ -27,6 +27,7 @@ namespace rtcl::test {
 namespace {
 
 using everywhere::describe;
+using everywhere::disagreements_with_brute;
 using everywhere::expect_at_level;
 using everywhere::make_ray;
 
@@ -443,14 +444,9 @@ TEST(TwoLevel, IdentityTranslatedAndMirroredInstancesAnswerAxisRaysExactly) {
       }
       const std::string what = std::string(precision_name(level)) + (query == Query::closest ? " closest" : " any");
       expect_at_level(level, false, what, [&] {
-        std::size_t differing = 0, failures = 0;
+        std::size_t failures = 0;
         std::string first;
-        for (std::size_t i = 0; i < rays.size(); ++i) {
-          const bool same = (mapped[i].prim < 0) == (expected[i].prim < 0) &&
-                            (query == Query::any || mapped[i].prim < 0 || mapped[i].t == expected[i].t);
-          if (!same && differing++ == 0)
-            first = "ray " + describe(rays[i]) + ": " + describe(mapped[i]) + ", brute force " + describe(expected[i]);
-        }
+        const std::size_t differing = disagreements_with_brute(rays, mapped, expected, query, &first);
         std::vector<std::string> judged = judge_all(flat.geometry, rays, mapped, query, &failures, 3);
         EXPECT_EQ(differing, 0u) << what << ", " << rays.size() << " rays; first: " << first;
         EXPECT_EQ(failures, 0u) << what << ": " << (judged.empty() ? "" : judged.front());

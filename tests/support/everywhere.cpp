@@ -34,6 +34,19 @@ std::string describe(const Hit& h) {
 
 const char* query_name(Query q) { return q == Query::closest ? "closest" : "any"; }
 
+std::size_t disagreements_with_brute(const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                                     const std::vector<Hit>& brute, Query query, std::string* first) {
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < rays.size(); ++i) {
+    const bool same = (hits[i].prim < 0) == (brute[i].prim < 0) &&
+                      (query == Query::any || hits[i].prim < 0 || hits[i].t == brute[i].t);
+    if (!same && count++ == 0)
+      *first = "ray " + std::to_string(i) + " " + describe(rays[i]) + ": " + describe(hits[i]) + ", brute force " +
+               describe(brute[i]);
+  }
+  return count;
+}
+
 void expect_at_level(Precision level, bool must_pass, const std::string& what, const std::function<void()>& evaluate) {
   if (level != Precision::fast || must_pass) return evaluate();
   testing::TestPartResultArray results;
@@ -94,16 +107,12 @@ void run_everywhere(const Geometry& geometry, const std::vector<Ray>& rays, cons
         const std::vector<Hit>& expected = brute_hits[query == Query::closest ? 0 : 1];
         std::vector<Hit> hits = accel ? run_query(*accel, rays, query, coherence) : expected;
         expect_at_level(level, options.fast_must_pass, what, [&] {
-          std::size_t disagreements = 0, failures = 0;
+          std::size_t failures = 0;
           std::string first, first_failure;
+          const std::size_t disagreements = disagreements_with_brute(rays, hits, expected, query, &first);
           std::vector<Ray> unjudged_rays;
           std::vector<Hit> unjudged_hits;
           for (std::size_t i = 0; i < rays.size(); ++i) {
-            bool same = (hits[i].prim < 0) == (expected[i].prim < 0) &&
-                        (query == Query::any || hits[i].prim < 0 || hits[i].t == expected[i].t);
-            if (!same && disagreements++ == 0)
-              first = "ray " + std::to_string(i) + " " + describe(rays[i]) + ": " + describe(hits[i]) +
-                      ", brute force " + describe(expected[i]);
             bool judged_already = !accel || (hits[i].prim == expected[i].prim && hits[i].t == expected[i].t &&
                                              hits[i].u == expected[i].u && hits[i].v == expected[i].v);
             if (options.judge && accel && !judged_already) {

@@ -23,6 +23,12 @@ std::string describe(const Ray& r);
 std::string describe(const Hit& h);
 const char* query_name(Query q);
 
+// How many of `hits` differ from brute force's answers `brute` at the same
+// level (hit or miss; a closest hit's t bit for bit), with the first of
+// them described in *first.
+std::size_t disagreements_with_brute(const std::vector<Ray>& rays, const std::vector<Hit>& hits,
+                                     const std::vector<Hit>& brute, Query query, std::string* first);
+
 // What a test checks beyond brute-force agreement, per accel and query (the
 // level is the one expect_at_level runs it for).
 using Check = std::function<void(const std::string& accel, Query query, const std::vector<Hit>& hits)>;
