@@ -17,6 +17,7 @@
 #include "rtcl/accel.hpp"
 #include "rtcl/device.hpp"
 #include "rtcl/cl/program.hpp"
+#include "rtcl/cl/upload_consuming.hpp"
 #include "rtcl/error.hpp"
 #include "support/error_of.hpp"
 #include "support/fixtures.hpp"
@@ -307,6 +308,27 @@ TEST(Device, OversizedBufferIsAnErrorNamingTheBuffer) {
   EXPECT_NE(upload.find(std::to_string(too_big)), std::string::npos) << upload;
   std::string allocate = error_of([&] { device.allocate(too_big, "oversized scratch"); });
   EXPECT_NE(allocate.find("oversized scratch"), std::string::npos) << allocate;
+}
+
+// upload_consuming copies in 16 MiB parts and discards each part's host
+// pages: the device copy must equal the data as it was (a copy kept apart),
+// for sizes below, at and across part boundaries and off page boundaries.
+TEST(Device, ConsumingUploadCopiesEveryPartWhole) {
+  const Device& device = test_device();
+  constexpr std::size_t kPart = std::size_t{16} << 20;
+  for (std::size_t bytes : {std::size_t{1}, std::size_t{4097}, kPart, kPart + 1, 2 * kPart + 12345}) {
+    std::vector<unsigned char> data(bytes + 3);  // consumed from offset 3: off every page boundary
+    for (std::size_t i = 0; i < data.size(); ++i) data[i] = static_cast<unsigned char>((i * 2654435761u) >> 13);
+    const std::vector<unsigned char> expected(data.begin() + 3, data.end());
+    cl::Buffer buffer = upload_consuming(device, data.data() + 3, bytes, "consumed test buffer");
+    std::vector<unsigned char> back(bytes);
+    device.queue().enqueueReadBuffer(buffer, CL_TRUE, 0, bytes, back.data());
+    EXPECT_TRUE(back == expected) << bytes << " bytes";
+  }
+  char byte = 0;  // never read: the size check comes first
+  const std::size_t too_big = device.info().max_alloc_bytes + 1;
+  std::string message = error_of([&] { upload_consuming(device, &byte, too_big, "oversized consumed buffer"); });
+  EXPECT_NE(message.find("oversized consumed buffer"), std::string::npos) << message;
 }
 
 TEST(Device, TraceRejectsTooSmallBuffersAndStaysInBounds) {

@@ -3,7 +3,8 @@
 // pages in can take a sizeable share of a multi-million-triangle build),
 // an array advised before its first touch is faulted in 2 MiB pages
 // instead, where the kernel allows them (Linux, transparent_hugepage
-// `madvise` or `always`); elsewhere the advice is a no-op.
+// `madvise` or `always`); elsewhere the advice is a no-op. And the other
+// way: pages of a consumed array handed back before the array is freed.
 #pragma once
 
 #include <cstddef>
@@ -20,6 +21,13 @@ void advise_huge_pages(void* data, std::size_t bytes) noexcept;
 
 // Reserves room for n elements in an empty vector and advises it (so
 // that the resize or fill that follows touches huge pages).
+// Gives the whole pages inside [data, data + bytes) back to the operating
+// system (Linux: MADV_DONTNEED; elsewhere a no-op): for an array the caller
+// no longer reads and frees soon, so that its resident size falls part by
+// part as it is consumed. The range's contents are unspecified afterwards
+// (zero on Linux); the allocation stays valid to free. Never fails.
+void discard_pages(void* data, std::size_t bytes) noexcept;
+
 template <class Vector>
 void reserve_advised(Vector& v, std::size_t n) {
   v.reserve(n);

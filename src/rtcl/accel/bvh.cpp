@@ -8,6 +8,7 @@
 
 #include "rtcl/accel/bvh_presplit.hpp"
 #include "rtcl/accel/refit.hpp"
+#include "rtcl/cl/upload_consuming.hpp"
 #include "rtcl/error.hpp"
 #include "rtcl/huge_pages.hpp"
 #include "rtcl/parallel.hpp"
@@ -69,28 +70,28 @@ BuildTree build_kind(std::span<const Aabb> bounds, std::span<const std::uint32_t
 }
 
 // The host image's nodes on the device; with `release`, the host nodes are
-// freed once uploaded.
+// consumed by the upload (upload_consuming) and freed.
 cl::Buffer upload_nodes(const Device& device, const Bvh8& bvh, Bvh8* release) {
-  cl::Buffer nodes = device.upload(bvh.nodes.data(), bvh.nodes.size() * sizeof(Bvh8Node), "BVH nodes");
-  if (release) std::vector<Bvh8Node>().swap(release->nodes);
+  const std::size_t bytes = bvh.nodes.size() * sizeof(Bvh8Node);
+  if (!release) return device.upload(bvh.nodes.data(), bytes, "BVH nodes");
+  cl::Buffer nodes = upload_consuming(device, release->nodes.data(), bytes, "BVH nodes");
+  std::vector<Bvh8Node>().swap(release->nodes);
   return nodes;
 }
 
-// The host image's blocks on the device; with `release`, the host blocks are
-// freed once uploaded.
+// The host image's blocks on the device; with `release`, consumed and
+// freed as the nodes.
 DevicePrimitives upload_blocks(const Device& device, const Bvh8& bvh, Bvh8* release) {
-  DevicePrimitives primitives = upload(device, bvh.blocks);
-  if (release) release->blocks = PrimitiveBlocks{};
-  return primitives;
+  return release ? upload_consuming(device, std::move(release->blocks)) : upload(device, bvh.blocks);
 }
 
 class BvhAccel final : public Accel {
  public:
   // Over the host image `bvh`. `release` is null or `bvh` itself, which the
-  // caller gives up: each of its arrays is then freed as soon as it is on
-  // the device, so that the build's peak memory holds one array's device
-  // copy beside the host image, not a device copy of all of it (the refit
-  // tables are made from the image first).
+  // caller gives up: each of its arrays is then consumed by its upload,
+  // its host pages handed back part by part as they reach the device, so
+  // that the build's peak memory never holds the host image and a device
+  // copy of it at once (the refit tables are made from the image first).
   BvhAccel(const Device& device, std::string name, const BvhConfig& bvh_config, std::vector<std::string> defines,
            const Bvh8& bvh, Bvh8* release, const Geometry& geometry, AccelStats stats, const AccelConfig& config)
       : Accel(device, std::move(name),

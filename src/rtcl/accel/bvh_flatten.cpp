@@ -474,6 +474,7 @@ class Flattener {
   // Pass 2: fills every block, the blocks of each kind split evenly over
   // the threads; the first thread's error (in block order) is the one thrown.
   void gather() {
+    reserve_advised(out_.blocks.triangles, triangle_sources_.size());
     out_.blocks.triangles.resize(triangle_sources_.size());
     out_.blocks.spheres.resize(sphere_sources_.size());
     std::size_t blocks = triangle_sources_.size() + sphere_sources_.size();

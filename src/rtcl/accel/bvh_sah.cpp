@@ -24,9 +24,10 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr std::uint32_t kMaxBins = 256;
-// Ranges binned with two sets of bins (bin_range); a root binned by several
-// threads, each part at least half this (find_split).
+// Ranges binned with two sets of bins, and with four (bin_range); a root
+// binned by several threads, each part at least half this (find_split).
 constexpr std::uint32_t kTwoSetMin = 1024;
+constexpr std::uint32_t kFourSetMin = 4096;
 constexpr std::uint32_t kParallelBinMin = 16384;
 // A child index in a subtree's nodes that names another subtree's root.
 constexpr std::uint32_t kSubtreeRef = 0x80000000u;
@@ -75,14 +76,12 @@ struct Box {
   Aabb aabb() const { return {{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
 };
 
-// Box::area of boxes[0..2] in lanes 0..2 (lane 3: 0), the same arithmetic
-// per lane.
-inline Float4 areas3(const Box (&boxes)[3]) {
-  const Float4 e0 = boxes[0].hi - boxes[0].lo, e1 = boxes[1].hi - boxes[1].lo, e2 = boxes[2].hi - boxes[2].lo;
-  const Float4 x = {e0[0], e1[0], e2[0], 0.0f}, y = {e0[1], e1[1], e2[1], 0.0f}, z = {e0[2], e1[2], e2[2], 0.0f};
-  const Float4 area = 2.0f * (x * y + y * z + z * x);
-  return x < Float4{0.0f, 0.0f, 0.0f, 0.0f} ? Float4{0.0f, 0.0f, 0.0f, 0.0f} : area;
-}
+// 8-wide vectors: a box as its lower corner and its upper one negated
+// (exact), so that one 8-wide min grows it (the bins, the split search's
+// sweep and the partition's centre bounds). Passed by reference only: by
+// value, a function's ABI would change without AVX.
+typedef float Float8 __attribute__((vector_size(32)));
+typedef int Int8 __attribute__((vector_size(32)));
 
 // A primitive during the build (SahRef, bvh_sah.hpp), partitioned in place
 // so that every subtree's primitives stay contiguous.
@@ -93,10 +92,12 @@ inline std::uint32_t id_of(const SahRef& r) { return std::bit_cast<std::uint32_t
 // can take a microcode assist (on the order of 100 cycles per operation),
 // and carried into the bins' boxes it would reach every area of the split
 // search. Masked, no arithmetic of the build touches it.
+// Read as two vector loads (a may_alias vector type, not a byte copy,
+// which the compiler staged through the stack in the hot loops).
+typedef float Float4Alias __attribute__((vector_size(16), may_alias));
 inline Box box_of(const SahRef& r) {
-  Box b = std::bit_cast<Box>(r);
-  b.hi = std::bit_cast<Float4>(std::bit_cast<Int4>(b.hi) & Int4{-1, -1, -1, 0});
-  return b;
+  const auto* v = reinterpret_cast<const Float4Alias*>(&r);
+  return {v[0], std::bit_cast<Float4>(std::bit_cast<Int4>(Float4(v[1])) & Int4{-1, -1, -1, 0})};
 }
 // Box centre, halves first (no overflow near the float range's ends); lane
 // 3 zero.
@@ -137,30 +138,39 @@ inline Int4 bins_of(Float4 centre, Float4 offset, Float4 scale, Float4 last_bin)
 }
 
 // Per axis and bin: the bounds of the references whose centre falls in it,
-// and their number. Trivially constructible: clear() the bins in use.
+// and their number. Trivially constructible: clear() the bins in use. A
+// bin's box is one 8-wide vector, its lower corner and its upper one
+// negated (exact), so that one min grows it (box() reads it back).
 struct Bins {
-  Box box[3][kMaxBins];
+  Float8 bounds[3][kMaxBins];
   std::uint32_t count[3][kMaxBins];
 
   void clear(std::uint32_t bins) {
     for (int a = 0; a < 3; ++a)
       for (std::uint32_t k = 0; k < bins; ++k) {
-        box[a][k] = Box::empty();
+        bounds[a][k] = Float8{kInf, kInf, kInf, kInf, kInf, kInf, kInf, kInf};
         count[a][k] = 0;
       }
   }
-  void add(Int4 k, const Box& b) {
+  // b: a box as lower corner and negated upper one.
+  void add(Int4 k, const Float8& b) {
     for (int a = 0; a < 3; ++a) {
-      box[a][k[a]].grow(b);
+      Float8& to = bounds[a][k[a]];
+      to = b < to ? b : to;
       ++count[a][k[a]];
     }
   }
   void merge(const Bins& other, std::uint32_t bins) {
     for (int a = 0; a < 3; ++a)
       for (std::uint32_t k = 0; k < bins; ++k) {
-        box[a][k].grow(other.box[a][k]);
+        const Float8& b = other.bounds[a][k];
+        bounds[a][k] = b < bounds[a][k] ? b : bounds[a][k];
         count[a][k] += other.count[a][k];
       }
+  }
+  Box box(int axis, std::uint32_t k) const {
+    const Float8& v = bounds[axis][k];
+    return {__builtin_shufflevector(v, v, 0, 1, 2, 3), -__builtin_shufflevector(v, v, 4, 5, 6, 7)};
   }
 };
 
@@ -300,24 +310,40 @@ class SahBuilder {
     const std::uint32_t k_count = map.count;
     Float4 right_area[kMaxBins];
     UInt4 right_n[kMaxBins];
-    Box acc[3] = {Box::empty(), Box::empty(), Box::empty()};
+    // acc: each axis's box in the bins' form (Bins)
+    const Float8 empty = {kInf, kInf, kInf, kInf, kInf, kInf, kInf, kInf};
+    Float8 acc[3] = {empty, empty, empty};
+    const auto grow = [&](std::uint32_t k) {
+      for (int a = 0; a < 3; ++a) acc[a] = bins.bounds[a][k] < acc[a] ? bins.bounds[a][k] : acc[a];
+    };
+    // Box::area of acc[0..2] in lanes 0..2 (lane 3: 0), the same arithmetic
+    // (upper - lower) per lane
+    const auto areas = [&] {
+      Float4 e[3];
+      for (int a = 0; a < 3; ++a)
+        e[a] = -__builtin_shufflevector(acc[a], acc[a], 4, 5, 6, 7) - __builtin_shufflevector(acc[a], acc[a], 0, 1, 2, 3);
+      const Float4 x = {e[0][0], e[1][0], e[2][0], 0.0f}, y = {e[0][1], e[1][1], e[2][1], 0.0f},
+                   z = {e[0][2], e[1][2], e[2][2], 0.0f};
+      const Float4 area = 2.0f * (x * y + y * z + z * x);
+      return x < Float4{0.0f, 0.0f, 0.0f, 0.0f} ? Float4{0.0f, 0.0f, 0.0f, 0.0f} : area;
+    };
     UInt4 count = {0, 0, 0, 0};
     for (std::uint32_t k = k_count - 1; k > 0; --k) {
-      for (int a = 0; a < 3; ++a) acc[a].grow(bins.box[a][k]);
+      grow(k);
       count += UInt4{bins.count[0][k], bins.count[1][k], bins.count[2][k], 0};
-      right_area[k] = areas3(acc);
+      right_area[k] = areas();
       right_n[k] = count;
     }
     const UInt4 zero = {0, 0, 0, 0};
     const UInt4 usable4 = {usable[0] ? ~0u : 0u, usable[1] ? ~0u : 0u, usable[2] ? ~0u : 0u, 0u};
     Float4 best_cost = {kInf, kInf, kInf, kInf};
     UInt4 best_bin = zero;
-    acc[0] = acc[1] = acc[2] = Box::empty();
+    acc[0] = acc[1] = acc[2] = empty;
     count = zero;
     for (std::uint32_t k = 1; k < k_count; ++k) {
-      for (int a = 0; a < 3; ++a) acc[a].grow(bins.box[a][k - 1]);
+      grow(k - 1);
       count += UInt4{bins.count[0][k - 1], bins.count[1][k - 1], bins.count[2][k - 1], 0};
-      const Float4 cost = areas3(acc) * blocks4(count) + right_area[k] * blocks4(right_n[k]);
+      const Float4 cost = areas() * blocks4(count) + right_area[k] * blocks4(right_n[k]);
       const UInt4 better = usable4 & (count != zero) & (right_n[k] != zero) & (cost < best_cost);
       best_cost = better ? cost : best_cost;
       best_bin = better ? UInt4{k, k, k, k} : best_bin;
@@ -332,7 +358,7 @@ class SahBuilder {
     if (best.axis >= 0) {
       int a = best.axis;
       best.map = map;
-      for (std::uint32_t k = 0; k < k_count; ++k) (k < best.bin ? best.left : best.right).grow(bins.box[a][k]);
+      for (std::uint32_t k = 0; k < k_count; ++k) (k < best.bin ? best.left : best.right).grow(bins.box(a, k));
     }
     return best;
   }
@@ -373,21 +399,38 @@ class SahBuilder {
     return area * blocks(range.end - range.begin) <= config_.node_cost * area + lower;
   }
 
-  // Adds refs_[begin, end) to bins. Long ranges alternate between two sets
-  // of bins: consecutive references often fall into the same bin, and with
-  // one set each update would wait for the store of the one before.
+  // Adds refs_[begin, end) to bins. Long ranges rotate through two or four
+  // sets of bins: consecutive references often fall into the same bin (on
+  // a connected mesh, most of them do deep in the tree), and with one set
+  // each update would wait for the store of the one before. Bins merge
+  // exactly (min, max and integer sums), so the sets change no result.
   RTCL_AVX2_CLONE void bin_range(std::uint32_t begin, std::uint32_t end, const BinMap& map, Bins& bins) const {
+    const auto add = [&](Bins& to, std::uint32_t i) {
+      const Box b = box_of(refs_[i]);
+      to.add(bins_of(0.5f * b.lo + 0.5f * b.hi, map.offset, map.scale, map.last_bin),
+             __builtin_shufflevector(b.lo, -b.hi, 0, 1, 2, 3, 4, 5, 6, 7));
+    };
     std::uint32_t i = begin;
     if (end - begin >= kTwoSetMin) {
-      std::unique_ptr<Bins> odd = std::make_unique<Bins>();
-      odd->clear(map.count);
-      for (; i + 1 < end; i += 2) {
-        bins.add(bins_of(centre_of(refs_[i]), map.offset, map.scale, map.last_bin), box_of(refs_[i]));
-        odd->add(bins_of(centre_of(refs_[i + 1]), map.offset, map.scale, map.last_bin), box_of(refs_[i + 1]));
+      const unsigned extra_sets = end - begin >= kFourSetMin ? 3 : 1;
+      std::unique_ptr<Bins[]> extra(new Bins[extra_sets]);
+      for (unsigned k = 0; k < extra_sets; ++k) extra[k].clear(map.count);
+      if (extra_sets == 3) {
+        for (; i + 3 < end; i += 4) {
+          add(bins, i);
+          add(extra[0], i + 1);
+          add(extra[1], i + 2);
+          add(extra[2], i + 3);
+        }
+      } else {
+        for (; i + 1 < end; i += 2) {
+          add(bins, i);
+          add(extra[0], i + 1);
+        }
       }
-      bins.merge(*odd, map.count);
+      for (unsigned k = 0; k < extra_sets; ++k) bins.merge(extra[k], map.count);
     }
-    for (; i < end; ++i) bins.add(bins_of(centre_of(refs_[i]), map.offset, map.scale, map.last_bin), box_of(refs_[i]));
+    for (; i < end; ++i) add(bins, i);
   }
 
   // Partitions the range by the split's plane; fills both sides' centre
@@ -400,10 +443,12 @@ class SahBuilder {
     const int a = split.axis;
     const float offset = split.map.offset[a], scale = split.map.scale[a];
     const auto bin = static_cast<float>(split.bin);
-    const Float4 inf = {kInf, kInf, kInf, kInf};
+    const Float8 inf = {kInf, kInf, kInf, kInf, kInf, kInf, kInf, kInf};
     // The centre bounds in locals, in registers for the loop (refs_' stores
-    // could alias the callers' ranges).
-    Box left_centres = left.centres, right_centres = right.centres;
+    // could alias the callers' ranges), each as its lower corner and its
+    // negated upper one: one 8-wide min grows both.
+    Float8 left_centres = __builtin_shufflevector(left.centres.lo, -left.centres.hi, 0, 1, 2, 3, 4, 5, 6, 7);
+    Float8 right_centres = __builtin_shufflevector(right.centres.lo, -right.centres.hi, 0, 1, 2, 3, 4, 5, 6, 7);
     SahRef* refs = refs_.get();
     std::uint32_t store = range.begin;
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
@@ -418,14 +463,16 @@ class SahBuilder {
       refs[i] = refs[store];
       refs[store] = r;
       store += goes_left;
-      const Int4 mask = Int4{0, 0, 0, 0} - static_cast<int>(goes_left);
-      left_centres.lo = min4(left_centres.lo, mask ? c : inf);
-      left_centres.hi = max4(left_centres.hi, mask ? c : -inf);
-      right_centres.lo = min4(right_centres.lo, mask ? inf : c);
-      right_centres.hi = max4(right_centres.hi, mask ? -inf : c);
+      const Int8 mask = Int8{0, 0, 0, 0, 0, 0, 0, 0} - static_cast<int>(goes_left);
+      const Float8 c8 = __builtin_shufflevector(c, -c, 0, 1, 2, 3, 4, 5, 6, 7);
+      const Float8 to_left = mask ? c8 : inf, to_right = mask ? inf : c8;
+      left_centres = to_left < left_centres ? to_left : left_centres;
+      right_centres = to_right < right_centres ? to_right : right_centres;
     }
-    left.centres = left_centres;
-    right.centres = right_centres;
+    left.centres = {__builtin_shufflevector(left_centres, left_centres, 0, 1, 2, 3),
+                    -__builtin_shufflevector(left_centres, left_centres, 4, 5, 6, 7)};
+    right.centres = {__builtin_shufflevector(right_centres, right_centres, 0, 1, 2, 3),
+                     -__builtin_shufflevector(right_centres, right_centres, 4, 5, 6, 7)};
     return store;
   }
 

@@ -1,4 +1,5 @@
 #include "rtcl/accel/primitive_blocks.hpp"
+#include "rtcl/cl/upload_consuming.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -53,19 +54,39 @@ std::size_t PrimitiveBlocks::bytes() const {
   return triangles.size() * sizeof(TriangleBlock) + spheres.size() * sizeof(SphereBlock);
 }
 
-DevicePrimitives upload(const Device& device, const PrimitiveBlocks& blocks) {
+namespace {
+
+// Each kind's blocks through upload(data, bytes, what); a kind with no
+// block gets its one-block placeholder.
+template <class Upload>
+DevicePrimitives upload_with(const Device& device, const PrimitiveBlocks& blocks, Upload upload) {
   DevicePrimitives out;
   TriangleBlock no_triangle{};
   SphereBlock no_sphere{};
   out.triangles = blocks.triangles.empty()
                       ? device.upload(&no_triangle, sizeof no_triangle, "triangle blocks")
-                      : device.upload(blocks.triangles.data(), blocks.triangles.size() * sizeof(TriangleBlock),
-                                      "triangle blocks");
+                      : upload(blocks.triangles.data(), blocks.triangles.size() * sizeof(TriangleBlock),
+                               "triangle blocks");
   out.spheres = blocks.spheres.empty()
                     ? device.upload(&no_sphere, sizeof no_sphere, "sphere blocks")
-                    : device.upload(blocks.spheres.data(), blocks.spheres.size() * sizeof(SphereBlock),
-                                    "sphere blocks");
+                    : upload(blocks.spheres.data(), blocks.spheres.size() * sizeof(SphereBlock), "sphere blocks");
   out.bytes = blocks.bytes();
+  return out;
+}
+
+}  // namespace
+
+DevicePrimitives upload(const Device& device, const PrimitiveBlocks& blocks) {
+  return upload_with(device, blocks, [&](const void* data, std::size_t bytes, const char* what) {
+    return device.upload(data, bytes, what);
+  });
+}
+
+DevicePrimitives upload_consuming(const Device& device, PrimitiveBlocks&& blocks) {
+  DevicePrimitives out = upload_with(device, blocks, [&](const void* data, std::size_t bytes, const char* what) {
+    return upload_consuming(device, const_cast<void*>(data), bytes, what);
+  });
+  blocks = PrimitiveBlocks{};
   return out;
 }
 

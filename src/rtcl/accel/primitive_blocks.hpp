@@ -55,6 +55,10 @@ struct DevicePrimitives {
   std::size_t bytes = 0;
 };
 DevicePrimitives upload(const Device& device, const PrimitiveBlocks& blocks);
+// The same, for blocks the caller gives up: each array's host pages go back
+// part by part as they reach the device (cl/upload_consuming.hpp), and
+// `blocks` is empty afterwards.
+DevicePrimitives upload_consuming(const Device& device, PrimitiveBlocks&& blocks);
 
 // Ids of the primitives a structure stores: every sphere and every triangle
 // whose area is not zero.
