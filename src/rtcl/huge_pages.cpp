@@ -9,13 +9,24 @@
 
 namespace rtcl {
 
+#ifdef __linux__
+namespace {
+
+// madvise(advice) over the whole `page`-sized pages (a power of two) inside
+// [data, data + bytes); nothing when there is none.
+void advise_whole_pages(void* data, std::size_t bytes, std::uintptr_t page, int advice) noexcept {
+  if (!data || page == 0) return;
+  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + page - 1) & ~(page - 1);
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(page - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, advice);
+}
+
+}  // namespace
+#endif
+
 void advise_huge_pages(void* data, std::size_t bytes) noexcept {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-  if (!data || bytes < kHugePageAdviceBytes) return;
-  constexpr std::uintptr_t kHuge = std::uintptr_t{2} << 20;
-  std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
-  std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+  if (bytes >= kHugePageAdviceBytes) advise_whole_pages(data, bytes, std::uintptr_t{2} << 20, MADV_HUGEPAGE);
 #else
   (void)data;
   (void)bytes;
@@ -24,11 +35,7 @@ void advise_huge_pages(void* data, std::size_t bytes) noexcept {
 
 void discard_pages(void* data, std::size_t bytes) noexcept {
 #if defined(__linux__) && defined(MADV_DONTNEED)
-  const auto page = static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE));
-  if (!data || page == 0) return;
-  std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(data) + page - 1) & ~(page - 1);
-  std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(data) + bytes) & ~(page - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+  advise_whole_pages(data, bytes, static_cast<std::uintptr_t>(sysconf(_SC_PAGESIZE)), MADV_DONTNEED);
 #else
   (void)data;
   (void)bytes;
