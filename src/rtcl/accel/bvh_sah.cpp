@@ -407,7 +407,7 @@ class SahBuilder {
   RTCL_AVX2_CLONE void bin_range(std::uint32_t begin, std::uint32_t end, const BinMap& map, Bins& bins) const {
     const auto add = [&](Bins& to, std::uint32_t i) {
       const Box b = box_of(refs_[i]);
-      to.add(bins_of(0.5f * b.lo + 0.5f * b.hi, map.offset, map.scale, map.last_bin),
+      to.add(bins_of(centre_of(refs_[i]), map.offset, map.scale, map.last_bin),
              __builtin_shufflevector(b.lo, -b.hi, 0, 1, 2, 3, 4, 5, 6, 7));
     };
     std::uint32_t i = begin;
