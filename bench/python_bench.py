@@ -9,11 +9,13 @@ each, built here as ray_sets.cpp builds them. Timed in Python, numpy
 conversion included (median of --repeat calls after one warm-up call):
 cast_rays (camera rays: plain, coherent=True, and in a scene with an
 instance, which traces two levels; diffuse rays) and test_occlusions
-(shadow rays). From the same session:
-  - rtcl_query_bench (the C++ host-array path, Accel::trace on Ray records,
-    and Embree's rtcIntersect1 on 2 threads, same camera rays);
-  - `rtcl bench --accel bvh` (Embree's rtcIntersect1 / rtcOccluded1 on the
-    same three ray sets, and rtcl's rate on device buffers).
+(shadow rays). The plain cast_rays on camera rays takes turns, call by
+call, with the library's own C++ host-array call on the same rays
+(Accel::trace on Ray records into Hit records, packed once, outside the
+timing: the module's internal rtcl._HostArrayBaseline), so that the
+Python / C++ ratio compares calls made back to back. From the same
+session, `rtcl bench --accel bvh`: Embree's rtcIntersect1 / rtcOccluded1
+on 2 threads on the same three ray sets.
 Then --points points uniform over the bunny's box grown by 10% per side:
 compute_distance and compute_closest_points against Open3D's (Debian's
 python3-open3d; its ray queries miss every ray on Debian 12, its point
@@ -24,9 +26,8 @@ compute_occupancy beside them.
       [--size 1024] [--repeat 5] [--rounds 1] [--points 1000000] [--no-cpp] [--no-open3d] [--json FILE]
 
 Run it on a quiet machine: it reports rates, and other work on the cores
-changes them. On a shared one, --rounds N takes the Python timings and
-rtcl_query_bench's N times in turn and reports the median of the rounds'
-Python / C++ ratios. The module is imported from BUILD/python unless PYTHONPATH
+changes them. --rounds N takes every timing N times in turn and reports
+the median of the rounds. The module is imported from BUILD/python unless PYTHONPATH
 already finds one.
 """
 import argparse
@@ -148,6 +149,22 @@ def median_ms(call, repeat):
     return float(np.median(times))
 
 
+def paired_ms(call_a, call_b, repeat):
+    """Median ms of two calls taking turns, call by call (one warm-up
+    pair; the order alternates pair by pair), and the median of the pairs'
+    ratios b / a: each ratio compares two calls made back to back, so a
+    change in the machine's load falls on both."""
+    call_a()
+    call_b()
+    a, b = [], []
+    for k in range(repeat):
+        for first in ((call_a, a), (call_b, b))[:: 1 if k % 2 == 0 else -1]:
+            start = time.perf_counter()
+            first[0]()
+            first[1].append((time.perf_counter() - start) * 1e3)
+    return float(np.median(a)), float(np.median(b)), float(np.median([y / x for x, y in zip(a, b)]))
+
+
 def interleaved_ms(calls, repeat):
     """Median ms of each call, the calls taking turns (one warm-up round)."""
     times = [[] for _ in calls]
@@ -158,24 +175,6 @@ def interleaved_ms(calls, repeat):
             if round_ > 0:
                 times[k].append((time.perf_counter() - start) * 1e3)
     return [float(np.median(t)) for t in times]
-
-
-def query_bench(build, scenes, size, repeat):
-    """rtcl_query_bench's table: per scene the host-array and Embree
-    rtcIntersect1 rates (Mrays/s) on the camera rays."""
-    exe = build / "bench" / "rtcl_query_bench"
-    if not exe.exists():
-        print(f"python_bench: {exe} not built (cmake --build {build} --target rtcl_query_bench)", file=sys.stderr)
-        return {}
-    out = subprocess.run([str(exe), "--scene", ",".join(scenes), "--size", str(size), "--repeat", str(repeat)],
-                         check=True, capture_output=True, text=True).stdout
-    rows = {}
-    for line in out.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) == 9 and cells[0] in scenes:
-            number = lambda s: float(s) if re.fullmatch(r"[0-9.]+", s) else None
-            rows[cells[0]] = {"cl_mem": number(cells[1]), "host": number(cells[2]), "embree": number(cells[5])}
-    return rows
 
 
 def rtcl_bench(build, scenes, size, repeat, scenes_dir):
@@ -207,9 +206,9 @@ def main():
     parser.add_argument("--size", type=int, default=1024, help="camera rays: size x size")
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--rounds", type=int, default=1,
-                        help="Python timings and rtcl_query_bench's taken this many times in turn")
+                        help="every timing taken this many times in turn")
     parser.add_argument("--points", type=int, default=1_000_000)
-    parser.add_argument("--no-cpp", action="store_true", help="leave out rtcl_query_bench and rtcl bench")
+    parser.add_argument("--no-cpp", action="store_true", help="leave out rtcl bench (the Embree figures)")
     parser.add_argument("--no-open3d", action="store_true")
     parser.add_argument("--json", help="also write the figures to this file")
     args = parser.parse_args()
@@ -242,35 +241,36 @@ def main():
         away = np.eye(4)
         away[:3, 3] = 100.0 * (v.max(axis=0) - v.min(axis=0))
         instanced.add_instance(0, away)
-        prepared[name] = (scene, instanced, camera_rays, shadow, diffuse)
+        # The library's C++ host-array call on the same camera rays, timed
+        # in this process, call by call with cast_rays.
+        baseline = rtcl._HostArrayBaseline(scene, camera_rays)
+        prepared[name] = (scene, instanced, camera_rays, shadow, diffuse, baseline)
         print(f"{name}: {len(f)} triangles, {len(shadow)} shadow and diffuse rays", flush=True)
 
-    # Rounds of the Python timings, each followed by rtcl_query_bench's, so
-    # that each Python / C++ ratio compares timings taken close together
-    # (on a shared machine the load changes within minutes).
     mrays = lambda count, ms: count / (ms * 1e3)
     rounds = []
     for _ in range(args.rounds):
-        python_rates = {}
-        for name, (scene, instanced, camera_rays, shadow, diffuse) in prepared.items():
+        python_rates, cpp = {}, {}
+        for name, (scene, instanced, camera_rays, shadow, diffuse, baseline) in prepared.items():
+            python_ms, cpp_ms, ratio = paired_ms(lambda: scene.cast_rays(camera_rays), baseline.trace, args.repeat)
+            cpp[name] = {"host": mrays(n, cpp_ms), "ratio": ratio}
             python_rates[name] = {
-                "primary": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays), args.repeat)),
+                "primary": mrays(n, python_ms),
                 "primary coherent": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays, coherent=True),
                                                        args.repeat)),
                 "primary instanced": mrays(n, median_ms(lambda: instanced.cast_rays(camera_rays), args.repeat)),
                 "shadow": mrays(len(shadow), median_ms(lambda: scene.test_occlusions(shadow, 0.0, 1.0), args.repeat)),
                 "diffuse": mrays(len(diffuse), median_ms(lambda: scene.cast_rays(diffuse), args.repeat)),
             }
-        cpp = {} if args.no_cpp else query_bench(build, scenes, args.size, args.repeat)
         rounds.append((python_rates, cpp))
     embree = {} if args.no_cpp else rtcl_bench(build, scenes, args.size, args.repeat, args.scenes_dir)
     median = lambda xs: float(np.median(xs)) if xs else None
     python_rates = {name: {rays: median([r[0][name][rays] for r in rounds]) for rays in rounds[0][0][name]}
                     for name in scenes}
-    hosts = {name: [r[1][name]["host"] for r in rounds if r[1].get(name, {}).get("host")] for name in scenes}
-    if args.rounds > 1:
-        print(f"\n{args.rounds} rounds: rates are medians over the rounds, Python/C++ the median of each "
-              "round's ratio")
+    hosts = {name: [r[1][name]["host"] for r in rounds] for name in scenes}
+    print(f"\n{args.rounds} round(s): rates are medians over the rounds; Python/C++ (primary cast_rays against "
+          "the C++ host-array call, taking turns call by call) the median over the rounds of each round's "
+          "median pair ratio")
 
     print("\n| scene | rays | Python Mrays/s | C++ host arrays | Python/C++ | Embree (2 threads) | Python/Embree |")
     print("|---|---|---|---|---|---|---|")
@@ -278,8 +278,12 @@ def main():
         for rays, rate in python_rates[name].items():
             kind = rays.split()[0]
             host = median(hosts[name]) if kind == "primary" else None
-            ratio = median([r[0][name][rays] / r[1][name]["host"] for r in rounds
-                            if r[1].get(name, {}).get("host")]) if host else None
+            if host and rays == "primary":
+                ratio = median([r[1][name]["ratio"] for r in rounds])
+            elif host:
+                ratio = median([r[0][name][rays] / r[1][name]["host"] for r in rounds])
+            else:
+                ratio = None
             base = embree.get((name, kind))
             cells = [name, rays + (" (test_occlusions)" if kind == "shadow" else " (cast_rays)"), f"{rate:.2f}",
                      f"{host:.2f}" if host else "-", f"{ratio:.2f}" if host else "-",
@@ -288,9 +292,9 @@ def main():
             results["rays"][f"{name} {rays}"] = {"python": rate, "cpp_host": host,
                                                  "embree": base[2] if base else None}
 
-    if args.rounds > 1 and not args.no_cpp:
+    if args.rounds > 1:
         for name in scenes:
-            each = [r[0][name]["primary"] / r[1][name]["host"] for r in rounds if r[1].get(name, {}).get("host")]
+            each = [r[1][name]["ratio"] for r in rounds]
             print(f"{name} primary Python/C++ by round: " + ", ".join(f"{x:.2f}" for x in each))
             results["rays"][f"{name} primary"]["ratio_by_round"] = each
 

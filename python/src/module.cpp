@@ -12,6 +12,7 @@
 
 namespace rtcl::python {
 void bind_render(pybind11::module_& m);
+void bind_host_array_baseline(pybind11::module_& m);
 }
 
 PYBIND11_MODULE(rtcl, m) {
@@ -31,4 +32,5 @@ PYBIND11_MODULE(rtcl, m) {
   rtcl::python::bind_devices(m);
   rtcl::python::bind_raycasting_scene(m);
   rtcl::python::bind_render(m);
+  rtcl::python::bind_host_array_baseline(m);
 }

@@ -107,19 +107,39 @@ class Helper {
 
 }  // namespace
 
+std::vector<std::size_t> chunk_bounds(std::size_t count) {
+  std::vector<std::size_t> front{0}, back{count};
+  if (count > 2 * kEdgeChunk) {
+    // The ramps: each chunk at most kRampFactor times its neighbour, so
+    // that the helper's conversions of a neighbour end before the device
+    // ends this chunk's work.
+    std::size_t left = count, size = kEdgeChunk, last = 0;
+    for (; size <= kChunk && left >= 2 * size + size; size *= kRampFactor) {
+      front.push_back(front.back() + size);
+      back.push_back(back.back() - size);
+      left -= 2 * size;
+      last = size;
+    }
+    // Between the ramps: equal chunks of at most kChunk; a remainder
+    // smaller than the ramps' largest chunk joins the first ramp's last
+    // chunk instead.
+    if (left < last) {
+      front.back() += left;
+      left = 0;
+    }
+    const std::size_t middle = (left + kChunk - 1) / kChunk;
+    const std::size_t start = front.back();
+    for (std::size_t k = 1; k < middle; ++k) front.push_back(start + left * k / middle);
+  }
+  front.insert(front.end(), back.rbegin(), back.rend());
+  return front;
+}
+
 void pipeline(std::size_t count, const std::function<void(int, std::size_t, std::size_t, bool)>& pack,
               const std::function<void(int, std::size_t, std::size_t)>& run,
               const std::function<void(int, std::size_t, std::size_t, bool)>& unpack) {
   if (count == 0) return;
-  // Chunk k is [bounds[k], bounds[k + 1]): one chunk up to kChunk, else a
-  // first and a last chunk of kEdgeChunk with chunks of kChunk between.
-  std::vector<std::size_t> bounds{0};
-  if (count > kChunk) {
-    bounds.push_back(kEdgeChunk);
-    for (std::size_t at = kEdgeChunk + kChunk; at < count - kEdgeChunk; at += kChunk) bounds.push_back(at);
-    bounds.push_back(count - kEdgeChunk);
-  }
-  bounds.push_back(count);
+  const std::vector<std::size_t> bounds = chunk_bounds(count);
   const std::size_t chunks = bounds.size() - 1;
   auto first = [&](std::size_t k) { return bounds[k]; };
   auto size = [&](std::size_t k) { return bounds[k + 1] - bounds[k]; };

@@ -286,13 +286,28 @@ def test_threads_adding_meshes_while_others_query():
     assert scene.geometry_count == 6
 
 
+@pytest.mark.parametrize("n", [32_768, 32_769, 49_152, 50_000, 262_144, 1_100_000])
+def test_split_calls_answer_every_ray_in_place(cube, n):
+    """Calls of more than 2^15 rays run in chunks of several sizes (a ramp
+    up, equal chunks, a ramp down): every ray's answer lands in its place,
+    at both ends and around each chunk bound."""
+    rays = down_rays(n, seed=n).astype(np.float32)
+    beside = np.unique(np.r_[0, n - 1, np.arange(7, n, 4099), np.arange(16_384, n, 16_384) - 1])
+    rays[beside, 0] = 5.0  # beside the cube: misses
+    ans = cube.cast_rays(rays)
+    expected = np.full(n, 4.0, np.float32)
+    expected[beside] = np.inf
+    assert np.array_equal(ans["t_hit"], expected)
+    assert np.array_equal(cube.test_occlusions(rays), expected == 4.0)
+
+
 def test_calls_larger_than_one_chunk(cube):
     """Calls of more rays or points than one library call takes (2^18) run
     in chunks: every chunk's answers land in their places."""
     n = 700_000
     rays = down_rays(n, seed=4)
-    rays[123_456, 3:] = 0.0  # one miss, in the first chunk
-    rays[654_321, 0] = 5.0  # and one in the third, beside the cube
+    rays[123_456, 3:] = 0.0  # one miss, in an early chunk
+    rays[654_321, 0] = 5.0  # and one in a late one, beside the cube
     shaped = np.asfortranarray(rays).reshape(2, n // 2, 6, order="F")[:, ::-1]  # float64, strided
     flat = shaped.reshape(-1, 6)
     miss = ~((np.abs(flat[:, 0]) < 1.0) & (flat[:, 5] != 0.0))
@@ -313,6 +328,6 @@ def test_calls_larger_than_one_chunk(cube):
     assert expected.sum() == n - 1
     assert np.array_equal(cube.compute_occupancy(inside), expected)
     bad = points.copy()
-    bad[600_001, 1] = np.inf  # in the last chunk: refused before the first
+    bad[600_001, 1] = np.inf  # in a late chunk: refused before the first
     with pytest.raises(ValueError, match=r"compute_distance: query_points\[600001\] has a NaN or infinite"):
         cube.compute_distance(bad)
