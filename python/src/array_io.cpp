@@ -162,11 +162,12 @@ std::size_t first_bad_point(const FloatRecords& r) {
 
 namespace {
 
-// Large output blocks that arrays gave back, kept for the next arrays of the
-// same size: a block used before costs no page faults (and no zeroing by
-// the kernel) when the next call writes it. At most kKeptBytes are kept;
-// a block beyond goes back to the system.
+// Output blocks of at least kKeptMinBytes that arrays gave back, kept for
+// the next arrays of the same size: a block used before costs no page
+// faults (and no zeroing by the kernel) when the next call writes it. At
+// most kKeptBytes are kept; a block beyond goes back to the system.
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
+constexpr std::size_t kKeptMinBytes = std::size_t{64} << 10;
 constexpr std::size_t kKeptBytes = std::size_t{512} << 20;
 
 struct KeptBlocks {
@@ -179,13 +180,16 @@ KeptBlocks& kept() {
   return *k;
 }
 
-std::size_t rounded(std::size_t bytes) { return (bytes + kHugePage - 1) / kHugePage * kHugePage; }
+// A kept block's size and alignment: huge pages from
+// kHugePageAdviceBytes up, 64 KiB below.
+std::size_t granule(std::size_t bytes) { return bytes >= kHugePageAdviceBytes ? kHugePage : kKeptMinBytes; }
+std::size_t rounded(std::size_t bytes) { return (bytes + granule(bytes) - 1) / granule(bytes) * granule(bytes); }
 
 }  // namespace
 
 void* output_memory(std::size_t bytes) {
   void* p = nullptr;
-  if (bytes >= kHugePageAdviceBytes) {
+  if (bytes >= kKeptMinBytes) {
     const std::size_t size = rounded(bytes);
     {
       KeptBlocks& k = kept();
@@ -197,8 +201,8 @@ void* output_memory(std::size_t bytes) {
         return p;
       }
     }
-    p = std::aligned_alloc(kHugePage, size);
-    if (p) advise_huge_pages(p, bytes);
+    p = std::aligned_alloc(granule(bytes), size);
+    if (p && bytes >= kHugePageAdviceBytes) advise_huge_pages(p, bytes);
   } else {
     p = std::malloc(std::max<std::size_t>(bytes, 1));
   }
@@ -207,7 +211,7 @@ void* output_memory(std::size_t bytes) {
 }
 
 void release_output_memory(void* p, std::size_t bytes) {
-  if (bytes >= kHugePageAdviceBytes) {
+  if (bytes >= kKeptMinBytes) {
     const std::size_t size = rounded(bytes);
     KeptBlocks& k = kept();
     std::lock_guard lock(k.mutex);

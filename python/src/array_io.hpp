@@ -78,9 +78,11 @@ Transform read_transform(py::handle object, const char* call, const char* param)
 // release_output_memory(p, bytes): from 4 MiB up aligned to 2 MiB and
 // advised for huge pages, so that its first touch (while the answers are
 // written) costs one page fault per 2 MiB, not per 4 KiB
-// (rtcl/huge_pages.hpp); such blocks, once given back, are kept (up to
-// 512 MiB) for the next arrays of the same size, which then cost no page
-// faults at all. Throws std::bad_alloc.
+// (rtcl/huge_pages.hpp). Blocks from 64 KiB up, once given back, are kept
+// (up to 512 MiB) for the next arrays of the same size, which then cost no
+// page faults at all (blocks of that size from malloc come fresh from the
+// system, or from heap pages it hands back, at every call). Throws
+// std::bad_alloc.
 void* output_memory(std::size_t bytes);
 void release_output_memory(void* p, std::size_t bytes);
 

@@ -112,9 +112,10 @@ std::vector<std::size_t> chunk_bounds(std::size_t count) {
   if (count > 2 * kEdgeChunk) {
     // The ramps: each chunk at most kRampFactor times its neighbour, so
     // that the helper's conversions of a neighbour end before the device
-    // ends this chunk's work.
+    // ends this chunk's work. A pair of ramp chunks is taken while at least
+    // one more of its size is left for between them.
     std::size_t left = count, size = kEdgeChunk, last = 0;
-    for (; size <= kChunk && left >= 2 * size + size; size *= kRampFactor) {
+    for (; size <= kChunk && left >= 3 * size; size *= kRampFactor) {
       front.push_back(front.back() + size);
       back.push_back(back.back() - size);
       left -= 2 * size;
