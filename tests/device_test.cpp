@@ -310,12 +310,12 @@ TEST(Device, OversizedBufferIsAnErrorNamingTheBuffer) {
   EXPECT_NE(allocate.find("oversized scratch"), std::string::npos) << allocate;
 }
 
-// upload_consuming copies in 16 MiB parts and discards each part's host
-// pages: the device copy must equal the data as it was (a copy kept apart),
-// for sizes below, at and across part boundaries and off page boundaries.
+// upload_consuming copies in parts and discards each part's host pages:
+// the device copy must equal the data as it was (a copy kept apart), for
+// sizes below, at and across part boundaries and off page boundaries.
 TEST(Device, ConsumingUploadCopiesEveryPartWhole) {
   const Device& device = test_device();
-  constexpr std::size_t kPart = std::size_t{16} << 20;
+  constexpr std::size_t kPart = kConsumingUploadPartBytes;
   for (std::size_t bytes : {std::size_t{1}, std::size_t{4097}, kPart, kPart + 1, 2 * kPart + 12345}) {
     std::vector<unsigned char> data(bytes + 3);  // consumed from offset 3: off every page boundary
     for (std::size_t i = 0; i < data.size(); ++i) data[i] = static_cast<unsigned char>((i * 2654435761u) >> 13);

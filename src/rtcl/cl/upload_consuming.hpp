@@ -10,9 +10,15 @@
 
 namespace rtcl {
 
-// Device::upload(data, bytes, what), after which the whole pages of [data,
-// data + bytes) are discarded (huge_pages.hpp, discard_pages): the caller
-// must not read them again, only free the array.
+// Bytes per part: two 2 MiB pages. At most one part exists twice (host
+// and device) at a time, which adds to the build's peak memory: 4 MiB is
+// about 4 B per triangle of a 1M-triangle BVH (docs/benchmarks.md).
+inline constexpr std::size_t kConsumingUploadPartBytes = std::size_t{4} << 20;
+
+// Device::upload(data, bytes, what) in parts of kConsumingUploadPartBytes,
+// the whole pages of each part discarded (huge_pages.hpp, discard_pages)
+// once it is on the device: the caller must not read [data, data + bytes)
+// again, only free the array.
 cl::Buffer upload_consuming(const Device& device, void* data, std::size_t bytes, const char* what);
 
 }  // namespace rtcl
