@@ -109,29 +109,26 @@ class Helper {
 
 std::vector<std::size_t> chunk_bounds(std::size_t count) {
   std::vector<std::size_t> front{0}, back{count};
-  if (count > 2 * kEdgeChunk) {
-    // The ramps: each chunk at most kRampFactor times its neighbour, so
-    // that the helper's conversions of a neighbour end before the device
-    // ends this chunk's work. A pair of ramp chunks is taken while at least
-    // one more of its size is left for between them.
-    std::size_t left = count, size = kEdgeChunk, last = 0;
-    for (; size <= kChunk && left >= 3 * size; size *= kRampFactor) {
-      front.push_back(front.back() + size);
-      back.push_back(back.back() - size);
-      left -= 2 * size;
-      last = size;
-    }
-    // Between the ramps: equal chunks of at most kChunk; a remainder
-    // smaller than the ramps' largest chunk joins the first ramp's last
-    // chunk instead.
-    if (left < last) {
-      front.back() += left;
-      left = 0;
-    }
-    const std::size_t middle = (left + kChunk - 1) / kChunk;
-    const std::size_t start = front.back();
-    for (std::size_t k = 1; k < middle; ++k) front.push_back(start + left * k / middle);
+  // The ramps: each chunk at most kRampFactor times its neighbour, so that
+  // the helper's conversions of a neighbour end before the device ends this
+  // chunk's work. A pair of ramp chunks is taken while at least one more of
+  // its size is left for between them (below 3 kEdgeChunk: one chunk).
+  std::size_t left = count, size = kEdgeChunk, last = 0;
+  for (; size <= kChunk && left >= 3 * size; size *= kRampFactor) {
+    front.push_back(front.back() + size);
+    back.push_back(back.back() - size);
+    left -= 2 * size;
+    last = size;
   }
+  // Between the ramps: equal chunks of at most kChunk; a remainder smaller
+  // than the ramps' largest chunk joins the first ramp's last chunk instead.
+  if (left < last) {
+    front.back() += left;
+    left = 0;
+  }
+  const std::size_t middle = (left + kChunk - 1) / kChunk;
+  const std::size_t start = front.back();
+  for (std::size_t k = 1; k < middle; ++k) front.push_back(start + left * k / middle);
   front.insert(front.end(), back.rbegin(), back.rend());
   return front;
 }

@@ -34,7 +34,7 @@ inline constexpr std::size_t kEdgeChunk = std::size_t{1} << 14;
 inline constexpr std::size_t kRampFactor = 4;
 
 // Where pipeline() splits [0, count): the chunks' bounds, 0 first and count
-// last. One chunk up to 2 kEdgeChunk; else chunks growing from kEdgeChunk
+// last. One chunk below 3 kEdgeChunk; else chunks growing from kEdgeChunk
 // by kRampFactor up to kChunk, equal chunks of at most kChunk, and the
 // same ramp down to a last chunk of kEdgeChunk.
 std::vector<std::size_t> chunk_bounds(std::size_t count);

@@ -288,9 +288,9 @@ def test_threads_adding_meshes_while_others_query():
 
 @pytest.mark.parametrize("n", [32_768, 32_769, 49_152, 50_000, 262_144, 1_100_000])
 def test_split_calls_answer_every_ray_in_place(cube, n):
-    """Calls of more than 2^15 rays run in chunks of several sizes (a ramp
-    up, equal chunks, a ramp down): every ray's answer lands in its place,
-    at both ends and around each chunk bound."""
+    """Calls of 3 x 2^14 rays and more run in chunks of several sizes (a
+    ramp up, equal chunks, a ramp down): every ray's answer lands in its
+    place, at both ends and around each chunk bound."""
     rays = down_rays(n, seed=n).astype(np.float32)
     beside = np.unique(np.r_[0, n - 1, np.arange(7, n, 4099), np.arange(16_384, n, 16_384) - 1])
     rays[beside, 0] = 5.0  # beside the cube: misses
