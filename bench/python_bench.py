@@ -33,7 +33,6 @@ already finds one.
 import argparse
 import json
 import os
-import re
 import subprocess
 import sys
 import tempfile

@@ -202,7 +202,7 @@ void* output_memory(std::size_t bytes) {
       }
     }
     p = std::aligned_alloc(granule(bytes), size);
-    if (p && bytes >= kHugePageAdviceBytes) advise_huge_pages(p, bytes);
+    if (p) advise_huge_pages(p, bytes);  // from kHugePageAdviceBytes up
   } else {
     p = std::malloc(std::max<std::size_t>(bytes, 1));
   }

@@ -12,7 +12,6 @@
 
 #include "array_io.hpp"
 #include "mesh_scene.hpp"
-#include "rtcl/error.hpp"
 
 namespace rtcl::python {
 
@@ -38,13 +37,6 @@ class HostArrayBaseline {
     built_->flat->accel->trace(Query::closest, Rays(std::span<const Ray>(rays_)), std::span<Hit>(hits_));
   }
 
-  // How many rays hit something in the last trace().
-  std::size_t hit_count() const {
-    std::size_t count = 0;
-    for (const Hit& h : hits_) count += h.prim >= 0;
-    return count;
-  }
-
  private:
   std::shared_ptr<const BuiltScene> built_;
   std::vector<Ray> rays_;
@@ -59,8 +51,7 @@ Internal, for bench/python_bench.py: the library's C++ host-array call on
 the rays of a flat RaycastingScene (packed once, here); trace() is that
 call alone, closest hit, incoherent. Not part of the API.)doc")
       .def(py::init<const MeshScene&, py::handle>(), py::arg("scene"), py::arg("rays"))
-      .def("trace", &HostArrayBaseline::trace)
-      .def("hit_count", &HostArrayBaseline::hit_count);
+      .def("trace", &HostArrayBaseline::trace);
 }
 
 }  // namespace rtcl::python

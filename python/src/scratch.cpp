@@ -105,8 +105,8 @@ class Helper {
   std::thread thread_;  // last: starts when the rest is ready
 };
 
-}  // namespace
-
+// Where pipeline() splits [0, count): the chunks' bounds, 0 first and count
+// last (pipeline's comment in scratch.hpp).
 std::vector<std::size_t> chunk_bounds(std::size_t count) {
   std::vector<std::size_t> front{0}, back{count};
   // The ramps: each chunk at most kRampFactor times its neighbour, so that
@@ -132,6 +132,8 @@ std::vector<std::size_t> chunk_bounds(std::size_t count) {
   front.insert(front.end(), back.rbegin(), back.rend());
   return front;
 }
+
+}  // namespace
 
 void pipeline(std::size_t count, const std::function<void(int, std::size_t, std::size_t, bool)>& pack,
               const std::function<void(int, std::size_t, std::size_t)>& run,
