@@ -18,9 +18,9 @@ void print_structures() {
     if (s.options.empty()) std::printf("    (no options)\n");
     for (const OptionSpec& o : s.options) {
       std::string range = option_range_text(o);
-      std::printf("    %-14s %-10s default %-8s %s\n", o.name.c_str(), option_type_name(o.type),
+      std::printf("    %-16s %-10s default %-8s %s\n", o.name.c_str(), option_type_name(o.type),
                   format_option_value(o.default_value).c_str(), range.empty() ? "" : range.c_str());
-      std::printf("    %-14s %s\n", "", o.help.c_str());
+      std::printf("    %-16s %s\n", "", o.help.c_str());
     }
   }
 }

@@ -26,6 +26,7 @@
 #include <atomic>
 #include <bit>
 #include <limits>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -91,6 +92,35 @@ struct WalkOutput {
   std::vector<Bvh8Node> nodes;
   std::vector<BlockSource> triangle_sources, sphere_sources;
   std::uint32_t stack_size = 0, depth = 0;
+};
+
+// The sources of one kind's blocks, in block order, left in the walks'
+// outputs (the top's, then each part's) rather than copied into one array.
+class BlockSources {
+ public:
+  void append(const std::vector<BlockSource>& run) {
+    if (run.empty()) return;
+    runs_.push_back({&run, size_});
+    size_ += run.size();
+  }
+  std::size_t size() const { return size_; }
+  // fn(sources, first): for each run that overlaps blocks [begin, end), in
+  // order, its part there; sources[i] fills block first + i.
+  template <class Fn>
+  void for_each_run(std::size_t begin, std::size_t end, Fn&& fn) const {
+    for (const Run& run : runs_) {
+      const std::size_t from = std::max(begin, run.first), to = std::min(end, run.first + run.sources->size());
+      if (from < to) fn(std::span<const BlockSource>(run.sources->data() + (from - run.first), to - from), from);
+    }
+  }
+
+ private:
+  struct Run {
+    const std::vector<BlockSource>* sources;
+    std::size_t first;  // the block sources[0] fills
+  };
+  std::vector<Run> runs_;
+  std::size_t size_ = 0;
 };
 
 // A wide node to form from binary node `binary` at index `wide`; stack:
@@ -180,21 +210,21 @@ class Flattener {
   // sizeable share of the flatten).
   void walk() {
     const Bvh8Node empty = empty_node();
-    WalkOutput top;
     std::vector<Deferred> deferred;
     const bool in_parts = tree_.nodes.size() >= kSplitMinNodes;
     const bool plan_by_part = in_parts && greedy_levels_ + 1 >= kSplitDepth;
     plan_ = plan_by_part ? CollapsePlan(tree_.nodes.size()) : plan_collapse(tree_, geometry_);
     visit(0);
-    top.nodes.emplace_back();
-    walk_from({0, 0, 0, 1}, top, in_parts ? &deferred : nullptr, empty);
-    std::vector<WalkOutput> parts(deferred.size());
+    walks_.resize(1);
+    walks_[0].nodes.emplace_back();
+    walk_from({0, 0, 0, 1}, walks_[0], in_parts ? &deferred : nullptr, empty);
+    walks_.resize(1 + deferred.size());
     for_each_index(deferred.size(), threads_, [&](std::size_t k) {
       if (plan_by_part) plan_subtree(tree_, geometry_, deferred[k].todo.binary, plan_);
-      parts[k].nodes.emplace_back();
-      walk_from(deferred[k].todo, parts[k], nullptr, empty);
+      walks_[1 + k].nodes.emplace_back();
+      walk_from(deferred[k].todo, walks_[1 + k], nullptr, empty);
     });
-    assemble(std::move(top), deferred, parts);
+    assemble(deferred);
   }
 
   // Forms the wide nodes of the subtree from `root` (whose node out.nodes
@@ -242,40 +272,36 @@ class Flattener {
     }
   }
 
-  // The top's and the parts' nodes and sources in one tree: the top's
-  // first, then each part's in the order of `deferred`, their indices
-  // moved by what comes before them. Parts are copied on whichever thread
-  // is free.
-  void assemble(WalkOutput top, const std::vector<Deferred>& deferred, std::vector<WalkOutput>& parts) {
+  // The top's and the parts' nodes in one array, the top's first, then
+  // each part's in the order of `deferred` (walks_[1 + k] is part k), their
+  // indices moved by what comes before them; parts are copied on
+  // whichever thread is free. The blocks' sources stay where the walks put
+  // them, in the same order.
+  void assemble(const std::vector<Deferred>& deferred) {
     struct Offsets {
       std::size_t nodes, triangles, spheres;
     };
-    std::vector<Offsets> offsets(parts.size());
-    Offsets end{top.nodes.size(), top.triangle_sources.size(), top.sphere_sources.size()};
-    out_.stack_size = top.stack_size;
-    out_.depth = top.depth;
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-      offsets[k] = end;
-      end.nodes += parts[k].nodes.size();
-      end.triangles += parts[k].triangle_sources.size();
-      end.spheres += parts[k].sphere_sources.size();
-      out_.stack_size = std::max(out_.stack_size, parts[k].stack_size);
-      out_.depth = std::max(out_.depth, parts[k].depth);
+    std::vector<Offsets> offsets(walks_.size());
+    Offsets end{0, 0, 0};
+    for (std::size_t w = 0; w < walks_.size(); ++w) {
+      offsets[w] = end;
+      end.nodes += walks_[w].nodes.size();
+      end.triangles += walks_[w].triangle_sources.size();
+      end.spheres += walks_[w].sphere_sources.size();
+      out_.stack_size = std::max(out_.stack_size, walks_[w].stack_size);
+      out_.depth = std::max(out_.depth, walks_[w].depth);
+      triangle_sources_.append(walks_[w].triangle_sources);
+      sphere_sources_.append(walks_[w].sphere_sources);
     }
     if (end.nodes > 0x7fffffffu) fail("too many nodes");
-    out_.nodes = std::move(top.nodes);
+    out_.nodes = std::move(walks_[0].nodes);
     reserve_advised(out_.nodes, end.nodes);
     out_.nodes.resize(end.nodes);
-    triangle_sources_ = std::move(top.triangle_sources);
-    reserve_advised(triangle_sources_, end.triangles);
-    triangle_sources_.resize(end.triangles);
-    sphere_sources_ = std::move(top.sphere_sources);
-    sphere_sources_.resize(end.spheres);
-    for (std::size_t k = 0; k < parts.size(); ++k)
-      out_.nodes[deferred[k].parent].child[deferred[k].lane] = static_cast<rtcl_i32>(offsets[k].nodes);
-    for_each_index(parts.size(), threads_, [&](std::size_t k) {
-      const WalkOutput& part = parts[k];
-      const Offsets& at = offsets[k];
+    for (std::size_t k = 0; k < deferred.size(); ++k)
+      out_.nodes[deferred[k].parent].child[deferred[k].lane] = static_cast<rtcl_i32>(offsets[1 + k].nodes);
+    for_each_index(deferred.size(), threads_, [&](std::size_t k) {
+      const WalkOutput& part = walks_[1 + k];
+      const Offsets& at = offsets[1 + k];
       const auto node_offset = static_cast<rtcl_i32>(at.nodes);
       const auto triangle_offset = static_cast<std::uint32_t>(at.triangles);
       const auto sphere_offset = static_cast<std::uint32_t>(at.spheres);
@@ -288,10 +314,6 @@ class Flattener {
             c = rebase_leaf(c, triangle_offset, sphere_offset);
         *to++ = node;
       }
-      std::copy(part.triangle_sources.begin(), part.triangle_sources.end(),
-                triangle_sources_.begin() + static_cast<std::ptrdiff_t>(at.triangles));
-      std::copy(part.sphere_sources.begin(), part.sphere_sources.end(),
-                sphere_sources_.begin() + static_cast<std::ptrdiff_t>(at.spheres));
     });
   }
 
@@ -482,40 +504,45 @@ class Flattener {
     seen_.assign(parts, std::vector<std::uint64_t>(geometry_.primitive_count() / 64 + 1, 0));
     // part k: the k-th share of each kind's blocks, on its own thread
     for_each_part(parts, parts, [&](unsigned k, std::size_t, std::size_t) {
-      gather_triangles(seen_[k], triangle_sources_.size() * k / parts, triangle_sources_.size() * (k + 1) / parts);
-      gather_spheres(seen_[k], sphere_sources_.size() * k / parts, sphere_sources_.size() * (k + 1) / parts);
+      triangle_sources_.for_each_run(triangle_sources_.size() * k / parts, triangle_sources_.size() * (k + 1) / parts,
+                                     [&](std::span<const BlockSource> sources, std::size_t first) {
+                                       gather_triangles(seen_[k], sources, first);
+                                     });
+      sphere_sources_.for_each_run(sphere_sources_.size() * k / parts, sphere_sources_.size() * (k + 1) / parts,
+                                   [&](std::span<const BlockSource> sources, std::size_t first) {
+                                     gather_spheres(seen_[k], sources, first);
+                                   });
     });
   }
 
-  void gather_triangles(std::vector<std::uint64_t>& seen, std::size_t begin, std::size_t end) {
-    for (std::size_t b = begin; b < std::min(end, begin + kIndexAhead); ++b) prefetch_indices(b);
-    for (std::size_t b = begin; b < std::min(end, begin + kVertexAhead); ++b) prefetch_vertices(b);
-    for (std::size_t b = begin; b < end; ++b) {
-      if (b + kIndexAhead < end) prefetch_indices(b + kIndexAhead);
-      if (b + kVertexAhead < end) prefetch_vertices(b + kVertexAhead);
-      fill_triangle_block(seen, b);
+  // Blocks first, first + 1, ... from sources.
+  void gather_triangles(std::vector<std::uint64_t>& seen, std::span<const BlockSource> sources, std::size_t first) {
+    const std::size_t n = sources.size();
+    for (std::size_t i = 0; i < std::min(n, kIndexAhead); ++i) prefetch_indices(sources[i]);
+    for (std::size_t i = 0; i < std::min(n, kVertexAhead); ++i) prefetch_vertices(sources[i]);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i + kIndexAhead < n) prefetch_indices(sources[i + kIndexAhead]);
+      if (i + kVertexAhead < n) prefetch_vertices(sources[i + kVertexAhead]);
+      fill_triangle_block(seen, sources[i], first + i);
     }
   }
 
   // The block's triangle records and its leaves' boxes.
-  void prefetch_indices(std::size_t block) const {
-    const BlockSource& source = triangle_sources_[block];
+  void prefetch_indices(const BlockSource& source) const {
     for (std::uint32_t lane = 0; lane < source.count; ++lane) {
       prefetch(&geometry_.triangles[source.prims[lane]]);
       if (lane == 0 || source.leaves[lane] != source.leaves[lane - 1]) prefetch(&tree_.nodes[source.leaves[lane]]);
     }
   }
 
-  void prefetch_vertices(std::size_t block) const {
-    const BlockSource& source = triangle_sources_[block];
+  void prefetch_vertices(const BlockSource& source) const {
     for (std::uint32_t lane = 0; lane < source.count; ++lane) {
       const glm::uvec3& t = geometry_.triangles[source.prims[lane]];
       for (int k = 0; k < 3; ++k) prefetch(&geometry_.vertices[t[k]]);
     }
   }
 
-  void fill_triangle_block(std::vector<std::uint64_t>& seen, std::size_t block) {
-    const BlockSource& source = triangle_sources_[block];
+  void fill_triangle_block(std::vector<std::uint64_t>& seen, const BlockSource& source, std::size_t block) {
     TriangleBlock out = empty_triangle_block();
     for (std::uint32_t lane = 0; lane < source.count; ++lane) {
       std::uint32_t p = source.prims[lane];
@@ -531,9 +558,9 @@ class Flattener {
     out_.blocks.triangles[block] = out;
   }
 
-  void gather_spheres(std::vector<std::uint64_t>& seen, std::size_t begin, std::size_t end) {
-    for (std::size_t block = begin; block < end; ++block) {
-      const BlockSource& source = sphere_sources_[block];
+  void gather_spheres(std::vector<std::uint64_t>& seen, std::span<const BlockSource> sources, std::size_t first) {
+    for (std::size_t i = 0; i < sources.size(); ++i) {
+      const BlockSource& source = sources[i];
       SphereBlock out = empty_sphere_block();
       for (std::uint32_t lane = 0; lane < source.count; ++lane) {
         std::uint32_t p = source.prims[lane];
@@ -542,7 +569,7 @@ class Flattener {
         mark(seen, p, false);
         set_lane(out, lane, p, geometry_.spheres[p - geometry_.triangles.size()]);
       }
-      out_.blocks.spheres[block] = out;
+      out_.blocks.spheres[first + i] = out;
     }
   }
 
@@ -597,7 +624,8 @@ class Flattener {
   CollapsePlan plan_;  // the layout below the greedy levels
   unsigned threads_ = 1;
   std::vector<std::atomic<std::uint8_t>> node_seen_;  // by the walks, on several threads
-  std::vector<BlockSource> triangle_sources_, sphere_sources_;  // per block of out_.blocks, same order
+  std::vector<WalkOutput> walks_;                      // the top's walk, then each part's
+  BlockSources triangle_sources_, sphere_sources_;     // per block of out_.blocks, same order
   std::vector<std::vector<std::uint64_t>> seen_;                // per gather thread: bit p = primitive p marked
   Bvh8 out_;
 };

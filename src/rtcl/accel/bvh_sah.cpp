@@ -124,7 +124,10 @@ struct Split {
   std::uint32_t bin = 0;  // left side: bins [0, bin)
   float cost = kInf;      // area-weighted, in block tests
   BinMap map;             // the bins of a centre
+  // The sides' boxes from the bins; when only some references were binned
+  // (sampled), the partition computes them instead.
   Box left = Box::empty(), right = Box::empty();
+  bool sampled = false;
 };
 
 // Bin indices of a centre along each axis, in [0, last_bin]; clamped as
@@ -285,6 +288,7 @@ class SahBuilder {
     }
     Bins bins;
     bins.clear(map.count);
+    const std::uint32_t stride = sample_stride(n);
     if (root && thread_count_ > 1 && n >= kParallelBinMin) {
       // the root: no other thread has work yet, so each bins a part
       const unsigned parts = part_count(n, thread_count_, kParallelBinMin / 2);
@@ -296,12 +300,14 @@ class SahBuilder {
           b = part_bins[part].get();
           b->clear(map.count);
         }
-        bin_range(range.begin + static_cast<std::uint32_t>(begin), range.begin + static_cast<std::uint32_t>(end), map,
-                  *b);
+        // the part's first reference of the stride's (counted from the range's
+        // begin, so that the samples do not depend on the parts)
+        const auto from = static_cast<std::uint32_t>((begin + stride - 1) / stride * stride);
+        bin_range(range.begin + from, range.begin + static_cast<std::uint32_t>(end), stride, map, *b);
       });
       for (unsigned part = 1; part < parts; ++part) bins.merge(*part_bins[part], map.count);
     } else {
-      bin_range(range.begin, range.end, map, bins);
+      bin_range(range.begin, range.end, stride, map, bins);
     }
     // The sweep, the three axes at once in the lanes of Float4 / UInt4
     // (lane 3 unused): per lane the same arithmetic as one axis at a time,
@@ -358,9 +364,16 @@ class SahBuilder {
     if (best.axis >= 0) {
       int a = best.axis;
       best.map = map;
+      best.sampled = stride > 1;
       for (std::uint32_t k = 0; k < k_count; ++k) (k < best.bin ? best.left : best.right).grow(bins.box(a, k));
     }
     return best;
+  }
+
+  // Every how many references find_split bins one in a node of n
+  // (SahConfig::binning_samples).
+  std::uint32_t sample_stride(std::uint32_t n) const {
+    return config_.binning_samples == 0 ? 1u : (n / config_.binning_samples) | 1u;
   }
 
   // Whether a leaf of the range's at most RTCL_BLOCK_WIDTH references is
@@ -399,38 +412,43 @@ class SahBuilder {
     return area * blocks(range.end - range.begin) <= config_.node_cost * area + lower;
   }
 
-  // Adds refs_[begin, end) to bins. Long ranges rotate through two or four
-  // sets of bins: consecutive references often fall into the same bin (on
-  // a connected mesh, most of them do deep in the tree), and with one set
-  // each update would wait for the store of the one before. Bins merge
-  // exactly (min, max and integer sums), so the sets change no result.
-  RTCL_AVX2_CLONE void bin_range(std::uint32_t begin, std::uint32_t end, const BinMap& map, Bins& bins) const {
+  // Adds refs_[begin], refs_[begin + stride], ... (those below end) to
+  // bins. Long runs rotate through two or four sets of bins: consecutive
+  // references often fall into the same bin (on a connected mesh, most of
+  // them do deep in the tree), and with one set each update would wait for
+  // the store of the one before. Bins merge exactly (min, max and integer
+  // sums), so the sets change no result. map is copied: the stores to bins
+  // could alias it, and the loops would reload it.
+  RTCL_AVX2_CLONE void bin_range(std::uint32_t begin, std::uint32_t end, std::uint32_t stride, const BinMap& map_in,
+                                 Bins& bins) const {
+    const BinMap map = map_in;
     const auto add = [&](Bins& to, std::uint32_t i) {
       const Box b = box_of(refs_[i]);
       to.add(bins_of(centre_of(refs_[i]), map.offset, map.scale, map.last_bin),
              __builtin_shufflevector(b.lo, -b.hi, 0, 1, 2, 3, 4, 5, 6, 7));
     };
-    std::uint32_t i = begin;
-    if (end - begin >= kTwoSetMin) {
-      const unsigned extra_sets = end - begin >= kFourSetMin ? 3 : 1;
+    const std::uint32_t samples = begin < end ? (end - begin - 1) / stride + 1 : 0;
+    std::uint32_t i = begin, k = 0;
+    if (samples >= kTwoSetMin) {
+      const unsigned extra_sets = samples >= kFourSetMin ? 3 : 1;
       std::unique_ptr<Bins[]> extra(new Bins[extra_sets]);
-      for (unsigned k = 0; k < extra_sets; ++k) extra[k].clear(map.count);
+      for (unsigned e = 0; e < extra_sets; ++e) extra[e].clear(map.count);
       if (extra_sets == 3) {
-        for (; i + 3 < end; i += 4) {
+        for (; k + 3 < samples; k += 4, i += 4 * stride) {
           add(bins, i);
-          add(extra[0], i + 1);
-          add(extra[1], i + 2);
-          add(extra[2], i + 3);
+          add(extra[0], i + stride);
+          add(extra[1], i + 2 * stride);
+          add(extra[2], i + 3 * stride);
         }
       } else {
-        for (; i + 1 < end; i += 2) {
+        for (; k + 1 < samples; k += 2, i += 2 * stride) {
           add(bins, i);
-          add(extra[0], i + 1);
+          add(extra[0], i + stride);
         }
       }
-      for (unsigned k = 0; k < extra_sets; ++k) bins.merge(extra[k], map.count);
+      for (unsigned e = 0; e < extra_sets; ++e) bins.merge(extra[e], map.count);
     }
-    for (; i < end; ++i) add(bins, i);
+    for (; k < samples; ++k, i += stride) add(bins, i);
   }
 
   // Partitions the range by the split's plane; fills both sides' centre
@@ -439,7 +457,9 @@ class SahBuilder {
   // right side, which then grows by one unless it went left): which side a
   // reference goes to is unpredictable, and a branch on it mispredicted
   // about every other time.
-  RTCL_AVX2_CLONE std::uint32_t partition(const Range& range, const Split& split, Range& left, Range& right) {
+  template <bool kBoxes>
+  [[gnu::always_inline]] inline std::uint32_t partition_impl(const Range& range, const Split& split, Range& left,
+                                                            Range& right) {
     const int a = split.axis;
     const float offset = split.map.offset[a], scale = split.map.scale[a];
     const auto bin = static_cast<float>(split.bin);
@@ -449,6 +469,7 @@ class SahBuilder {
     // negated upper one: one 8-wide min grows both.
     Float8 left_centres = __builtin_shufflevector(left.centres.lo, -left.centres.hi, 0, 1, 2, 3, 4, 5, 6, 7);
     Float8 right_centres = __builtin_shufflevector(right.centres.lo, -right.centres.hi, 0, 1, 2, 3, 4, 5, 6, 7);
+    Float8 left_boxes = inf, right_boxes = inf;
     SahRef* refs = refs_.get();
     std::uint32_t store = range.begin;
     for (std::uint32_t i = range.begin; i < range.end; ++i) {
@@ -468,12 +489,36 @@ class SahBuilder {
       const Float8 to_left = mask ? c8 : inf, to_right = mask ? inf : c8;
       left_centres = to_left < left_centres ? to_left : left_centres;
       right_centres = to_right < right_centres ? to_right : right_centres;
+      if constexpr (kBoxes) {
+        const Box b = box_of(r);
+        const Float8 b8 = __builtin_shufflevector(b.lo, -b.hi, 0, 1, 2, 3, 4, 5, 6, 7);
+        const Float8 box_left = mask ? b8 : inf, box_right = mask ? inf : b8;
+        left_boxes = box_left < left_boxes ? box_left : left_boxes;
+        right_boxes = box_right < right_boxes ? box_right : right_boxes;
+      }
+    }
+    if constexpr (kBoxes) {
+      left.bounds.grow({__builtin_shufflevector(left_boxes, left_boxes, 0, 1, 2, 3),
+                        -__builtin_shufflevector(left_boxes, left_boxes, 4, 5, 6, 7)});
+      right.bounds.grow({__builtin_shufflevector(right_boxes, right_boxes, 0, 1, 2, 3),
+                         -__builtin_shufflevector(right_boxes, right_boxes, 4, 5, 6, 7)});
     }
     left.centres = {__builtin_shufflevector(left_centres, left_centres, 0, 1, 2, 3),
                     -__builtin_shufflevector(left_centres, left_centres, 4, 5, 6, 7)};
     right.centres = {__builtin_shufflevector(right_centres, right_centres, 0, 1, 2, 3),
                      -__builtin_shufflevector(right_centres, right_centres, 4, 5, 6, 7)};
     return store;
+  }
+
+  RTCL_AVX2_CLONE std::uint32_t partition(const Range& range, const Split& split, Range& left, Range& right) {
+    return partition_impl<false>(range, split, left, right);
+  }
+  RTCL_AVX2_CLONE std::uint32_t partition_with_boxes(const Range& range, const Split& split, Range& left,
+                                                     Range& right) {
+    return partition_impl<true>(range, split, left, right);
+  }
+  std::uint32_t partition_any(const Range& range, const Split& split, Range& left, Range& right) {
+    return split.sampled ? partition_with_boxes(range, split, left, right) : partition(range, split, left, right);
   }
 
   // The root's partition: each half of the range partitioned as by
@@ -487,7 +532,7 @@ class SahBuilder {
     Range sides[2][2] = {{left, right}, {left, right}};  // [half][left, right]: centre bounds only
     std::uint32_t store[2] = {0, 0};
     for_each_part(2, thread_count_ > 1 ? 2u : 1u, [&](unsigned, std::size_t begin, std::size_t end) {
-      for (std::size_t h = begin; h < end; ++h) store[h] = partition(halves[h], split, sides[h][0], sides[h][1]);
+      for (std::size_t h = begin; h < end; ++h) store[h] = partition_any(halves[h], split, sides[h][0], sides[h][1]);
     });
     const std::uint32_t first_right = mid - store[0], second_left = store[1] - mid;
     SahRef* refs = refs_.get();
@@ -499,6 +544,8 @@ class SahBuilder {
       Range& out = side == 0 ? left : right;
       out.centres.grow(sides[0][side].centres);
       out.centres.grow(sides[1][side].centres);
+      out.bounds.grow(sides[0][side].bounds);
+      out.bounds.grow(sides[1][side].bounds);
     }
     return store[0] + second_left;
   }
@@ -546,9 +593,11 @@ class SahBuilder {
     Range left{range.begin, 0, Box::empty(), Box::empty()}, right{0, range.end, Box::empty(), Box::empty()};
     if (split.axis >= 0) {
       left.end = right.begin = root && n >= kParallelBinMin ? partition_halves(range, split, left, right)
-                                                             : partition(range, split, left, right);
-      left.bounds = split.left;
-      right.bounds = split.right;
+                                                             : partition_any(range, split, left, right);
+      if (!split.sampled) {
+        left.bounds = split.left;
+        right.bounds = split.right;
+      }
     }
     // The partition recomputes the bins the counts came from, so neither side
     // is empty; should rounding ever disagree, the median split takes over.
