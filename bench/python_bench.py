@@ -9,13 +9,15 @@ each, built here as ray_sets.cpp builds them. Timed in Python, numpy
 conversion included (median of --repeat calls after one warm-up call):
 cast_rays (camera rays: plain, coherent=True, and in a scene with an
 instance, which traces two levels; diffuse rays) and test_occlusions
-(shadow rays). The plain cast_rays on camera rays takes turns, call by
-call, with the library's own C++ host-array call on the same rays
-(Accel::trace on Ray records into Hit records, packed once, outside the
-timing: the module's internal rtcl._HostArrayBaseline), so that the
-Python / C++ ratio compares calls made back to back. From the same
-session, `rtcl bench --accel bvh`: Embree's rtcIntersect1 / rtcOccluded1
-on 2 threads on the same three ray sets.
+(shadow rays). The plain cast_rays on camera rays and test_occlusions on
+the shadow rays take turns, call by call, with the library's own C++
+host-array call on the same rays (Accel::trace, closest hit and any hit,
+on Ray records into Hit records, packed once, outside the timing: the
+module's internal rtcl._HostArrayBaseline), so that each Python / C++
+ratio compares calls made back to back. From the same session,
+`rtcl bench --accel bvh --embree-threads 2`: Embree's rtcIntersect1 /
+rtcOccluded1 on 2 threads (the count is printed) on the same three ray
+sets.
 Then --points points uniform over the bunny's box grown by 10% per side:
 compute_distance and compute_closest_points against Open3D's (Debian's
 python3-open3d; its ray queries miss every ray on Debian 12, its point
@@ -42,6 +44,10 @@ from pathlib import Path
 import numpy as np
 
 REPO = Path(__file__).resolve().parents[1]
+
+# The threads Embree traces on (rtcl bench --embree-threads): the issue's
+# baseline is Embree on 2 threads, whatever the machine has.
+EMBREE_THREADS = 2
 
 # bench/support/scene_catalog.cpp: file, camera (eye, target, up, vertical
 # fov in degrees), point light.
@@ -177,8 +183,8 @@ def interleaved_ms(calls, repeat):
 
 
 def rtcl_bench(build, scenes, size, repeat, scenes_dir):
-    """`rtcl bench --accel bvh` on the three ray sets: Embree's rates
-    (Mrays/s) per (scene, ray set)."""
+    """`rtcl bench --accel bvh --embree-threads EMBREE_THREADS` on the three
+    ray sets: Embree's (api, threads, Mrays/s) per (scene, ray set)."""
     exe = build / "rtcl"
     if not exe.exists():
         print(f"python_bench: {exe} not built", file=sys.stderr)
@@ -186,6 +192,7 @@ def rtcl_bench(build, scenes, size, repeat, scenes_dir):
     with tempfile.TemporaryDirectory() as out:
         subprocess.run([str(exe), "bench", "--accel", "bvh", "--scene", ",".join(scenes), "--rays",
                         "primary,shadow,diffuse", "--size", str(size), "--repeat", str(repeat), "--check-rays", "0",
+                        "--embree-threads", str(EMBREE_THREADS),
                         "--device", "0", "--scenes-dir", str(scenes_dir), "-o", out], check=True, capture_output=True, text=True)
         report = json.loads((Path(out) / "bench.json").read_text())
     rates = {}
@@ -222,7 +229,8 @@ def main():
     device = rtcl.devices()[0]["name"]
     n = args.size * args.size
     print(f"device: {device}; {args.size} x {args.size} camera rays per scene; medians of {args.repeat} calls\n")
-    results = {"device": device, "size": args.size, "repeat": args.repeat, "rays": {}, "points": {}}
+    results = {"device": device, "size": args.size, "repeat": args.repeat, "embree_threads_requested": EMBREE_THREADS,
+               "rays": {}, "points": {}}
 
     prepared = {}
     for name in scenes:
@@ -242,23 +250,30 @@ def main():
         instanced.add_instance(0, away)
         # The library's C++ host-array call on the same camera rays, timed
         # in this process, call by call with cast_rays.
-        baseline = rtcl._HostArrayBaseline(scene, camera_rays)
-        prepared[name] = (scene, instanced, camera_rays, shadow, diffuse, baseline)
+        # And its any-hit call on the shadow rays (t in [0, 1]), call by
+        # call with test_occlusions.
+        baselines = {"primary": rtcl._HostArrayBaseline(scene, camera_rays).trace,
+                     "shadow": rtcl._HostArrayBaseline(scene, shadow, 0.0, 1.0).occluded}
+        prepared[name] = (scene, instanced, camera_rays, shadow, diffuse, baselines)
         print(f"{name}: {len(f)} triangles, {len(shadow)} shadow and diffuse rays", flush=True)
 
     mrays = lambda count, ms: count / (ms * 1e3)
     rounds = []
     for _ in range(args.rounds):
         python_rates, cpp = {}, {}
-        for name, (scene, instanced, camera_rays, shadow, diffuse, baseline) in prepared.items():
-            python_ms, cpp_ms, ratio = paired_ms(lambda: scene.cast_rays(camera_rays), baseline.trace, args.repeat)
-            cpp[name] = {"host": mrays(n, cpp_ms), "ratio": ratio}
+        for name, (scene, instanced, camera_rays, shadow, diffuse, baselines) in prepared.items():
+            python_ms, cpp_ms, ratio = paired_ms(lambda: scene.cast_rays(camera_rays), baselines["primary"],
+                                                 args.repeat)
+            shadow_ms, shadow_cpp_ms, shadow_ratio = paired_ms(lambda: scene.test_occlusions(shadow, 0.0, 1.0),
+                                                               baselines["shadow"], args.repeat)
+            cpp[name] = {"primary": {"host": mrays(n, cpp_ms), "ratio": ratio},
+                         "shadow": {"host": mrays(len(shadow), shadow_cpp_ms), "ratio": shadow_ratio}}
             python_rates[name] = {
                 "primary": mrays(n, python_ms),
                 "primary coherent": mrays(n, median_ms(lambda: scene.cast_rays(camera_rays, coherent=True),
                                                        args.repeat)),
                 "primary instanced": mrays(n, median_ms(lambda: instanced.cast_rays(camera_rays), args.repeat)),
-                "shadow": mrays(len(shadow), median_ms(lambda: scene.test_occlusions(shadow, 0.0, 1.0), args.repeat)),
+                "shadow": mrays(len(shadow), shadow_ms),
                 "diffuse": mrays(len(diffuse), median_ms(lambda: scene.cast_rays(diffuse), args.repeat)),
             }
         rounds.append((python_rates, cpp))
@@ -266,21 +281,28 @@ def main():
     median = lambda xs: float(np.median(xs)) if xs else None
     python_rates = {name: {rays: median([r[0][name][rays] for r in rounds]) for rays in rounds[0][0][name]}
                     for name in scenes}
-    hosts = {name: [r[1][name]["host"] for r in rounds] for name in scenes}
-    print(f"\n{args.rounds} round(s): rates are medians over the rounds; Python/C++ (primary cast_rays against "
-          "the C++ host-array call, taking turns call by call) the median over the rounds of each round's "
-          "median pair ratio")
+    paired = ("primary", "shadow")  # the ray sets timed in turn with the C++ host-array call
+    hosts = {(name, kind): [r[1][name][kind]["host"] for r in rounds] for name in scenes for kind in paired}
+    threads = sorted({b[1] for b in embree.values() if isinstance(b, tuple)})
+    results["embree_threads"] = threads
+    if not args.no_cpp:
+        print(f"\nEmbree (rtcl bench --embree-threads {EMBREE_THREADS}): "
+              f"{', '.join(map(str, threads)) or 'no'} thread(s) as reported")
+    print(f"\n{args.rounds} round(s): rates are medians over the rounds; Python/C++ (primary cast_rays and "
+          "shadow test_occlusions against the C++ host-array call, closest hit and any hit, taking turns call "
+          "by call) the median over the rounds of each round's median pair ratio")
 
-    print("\n| scene | rays | Python Mrays/s | C++ host arrays | Python/C++ | Embree (2 threads) | Python/Embree |")
+    embree_head = f"Embree ({'/'.join(map(str, threads)) or EMBREE_THREADS} threads)"
+    print(f"\n| scene | rays | Python Mrays/s | C++ host arrays | Python/C++ | {embree_head} | Python/Embree |")
     print("|---|---|---|---|---|---|---|")
     for name in scenes:
         for rays, rate in python_rates[name].items():
             kind = rays.split()[0]
-            host = median(hosts[name]) if kind == "primary" else None
-            if host and rays == "primary":
-                ratio = median([r[1][name]["ratio"] for r in rounds])
-            elif host:
-                ratio = median([r[0][name][rays] / r[1][name]["host"] for r in rounds])
+            host = median(hosts[(name, kind)]) if kind in paired else None
+            if host and rays in paired:
+                ratio = median([r[1][name][kind]["ratio"] for r in rounds])
+            elif host:  # coherent and instanced camera rays against the plain C++ call
+                ratio = median([r[0][name][rays] / r[1][name][kind]["host"] for r in rounds])
             else:
                 ratio = None
             base = embree.get((name, kind))
@@ -288,14 +310,16 @@ def main():
                      f"{host:.2f}" if host else "-", f"{ratio:.2f}" if host else "-",
                      f"{base[2]:.2f} {base[0]}" if base else "-", f"{rate / base[2]:.2f}" if base else "-"]
             print("| " + " | ".join(cells) + " |")
-            results["rays"][f"{name} {rays}"] = {"python": rate, "cpp_host": host,
-                                                 "embree": base[2] if base else None}
+            results["rays"][f"{name} {rays}"] = {"python": rate, "cpp_host": host, "python_over_cpp": ratio,
+                                                 "embree": base[2] if base else None,
+                                                 "embree_threads": base[1] if base else None}
 
     if args.rounds > 1:
         for name in scenes:
-            each = [r[1][name]["ratio"] for r in rounds]
-            print(f"{name} primary Python/C++ by round: " + ", ".join(f"{x:.2f}" for x in each))
-            results["rays"][f"{name} primary"]["ratio_by_round"] = each
+            for kind in paired:
+                each = [r[1][name][kind]["ratio"] for r in rounds]
+                print(f"{name} {kind} Python/C++ by round: " + ", ".join(f"{x:.2f}" for x in each))
+                results["rays"][f"{name} {kind}"]["ratio_by_round"] = each
 
     # Point queries on the bunny.
     v, f = load_obj(Path(args.scenes_dir) / SCENES["bunny"][0])

@@ -252,6 +252,13 @@ FloatRecords float_records(py::handle object, int width, const char* call, const
   if (kind != 'f' || (itemsize != 4 && itemsize != 8))
     throw py::type_error(std::string(call) + ": " + param + " has dtype " + dtype_text(r.array) +
                          "; expected float32 or float64");
+  // Values in the other byte order ('>f4' on a little-endian machine):
+  // numpy converts them to the native order (one copy), so that every
+  // reader below reads native values.
+  if (!r.array.dtype().attr("isnative").cast<bool>()) {
+    r.array = py::array::ensure(r.array.attr("astype")(r.array.dtype().attr("newbyteorder")("=")));
+    if (!r.array) throw py::error_already_set();
+  }
   std::vector<py::ssize_t> full(r.array.shape(), r.array.shape() + r.array.ndim());
   if (r.array.ndim() < 1 || full.back() != width || (matrix && r.array.ndim() != 2))
     throw py::value_error(std::string(call) + ": " + param + " has shape " + shape_text(full) + "; expected (" +

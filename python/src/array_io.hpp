@@ -5,7 +5,11 @@
 // Inputs of records (rays: 6 values, points: 3) are float32 or float64
 // arrays of any leading shape, with the record along the last axis, any
 // strides (non-contiguous views and unaligned buffers included); anything
-// numpy.asarray accepts (lists, ...) is converted by numpy first.
+// numpy.asarray accepts (lists, ...) is converted by numpy first, and so are
+// values in the non-native byte order ('>f4' on a little-endian machine:
+// one copy by numpy into the native order). Integer inputs (triangles) and
+// create_rays_pinhole's matrices are converted by numpy (forcecast), which
+// handles any byte order the same way.
 #pragma once
 
 #include <pybind11/numpy.h>

@@ -5,6 +5,7 @@ import os
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -12,6 +13,17 @@ REPO = Path(__file__).resolve().parents[2]
 def scenes_dir():
     """$RTCL_SCENES_DIR, else ../shared/scenes beside the repository."""
     return Path(os.environ.get("RTCL_SCENES_DIR", REPO.parent / "shared" / "scenes"))
+
+
+def mesh_file(relative):
+    """The path of a shared mesh under scenes_dir(). A missing mesh fails
+    the test, as in the C++ suite (tests/support/fixtures.hpp: every test
+    finds meshes there and fails when one is missing), never skips it."""
+    path = scenes_dir() / relative
+    if not path.is_file():
+        pytest.fail(f"{path} not found: the tests need the shared meshes (set RTCL_SCENES_DIR; "
+                    "docs/test-meshes.md)", pytrace=False)
+    return path
 
 
 def load_obj(path):

@@ -57,6 +57,18 @@ class Mesh:
         margin[bad] = -np.inf
         return t, margin
 
+    def pair_uvs(self, o, d, prims):
+        """The barycentric (u, v) of the plane hit of ray (o[i], d[i]) with
+        triangle prims[i]: the point is (1 - u - v) a + u b + v c."""
+        e1, e2, a = self.e1[prims], self.e2[prims], self.a[prims]
+        p = np.cross(d, e2)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = 1.0 / np.einsum("ij,ij->i", e1, p)
+            s = o - a
+            u = np.einsum("ij,ij->i", s, p) * inv
+            v = np.einsum("ij,ij->i", d, np.cross(s, e1)) * inv
+        return u, v
+
     def candidates(self, origins, directions, chunk=64):
         """(ray, triangle) pairs whose triangle's bounding sphere the ray's
         line passes within a tolerance of: a superset of every hit."""

@@ -331,3 +331,95 @@ def test_calls_larger_than_one_chunk(cube):
     bad[600_001, 1] = np.inf  # in a late chunk: refused before the first
     with pytest.raises(ValueError, match=r"compute_distance: query_points\[600001\] has a NaN or infinite"):
         cube.compute_distance(bad)
+
+
+def swapped(a, dtype):
+    """`a` as `dtype` in the byte order that is not this machine's ('>f4'
+    on x86): the same values, other bytes."""
+    out = np.asarray(a).astype(np.dtype(dtype).newbyteorder("S"))
+    assert not out.dtype.isnative
+    return out
+
+
+def same_answers(a, b):
+    if isinstance(a, dict):
+        assert a.keys() == b.keys()
+        for key in a:
+            assert np.array_equal(a[key], b[key]), key
+    else:
+        assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_non_native_byte_order_rays_and_points(dtype):
+    """Rays and points in the other byte order give the native arrays'
+    answers, for every query (numpy converts them first), strided too."""
+    from meshes import icosphere
+    scene = rtcl.RaycastingScene()
+    scene.add_triangles(*icosphere(2))
+    rng = np.random.default_rng(21)
+    o = rng.uniform(-2.0, 2.0, (300, 3))
+    rays = np.concatenate([o, rng.normal(size=(300, 3))], axis=1).astype(dtype)
+    other = swapped(rays, dtype)
+    native = scene.cast_rays(rays)
+    assert 30 < np.isfinite(native["t_hit"]).sum() < 270  # hits and misses
+    same_answers(native, scene.cast_rays(other))
+    same_answers(scene.cast_rays(rays.reshape(3, 100, 6)[:, ::2]), scene.cast_rays(other.reshape(3, 100, 6)[:, ::2]))
+    same_answers(scene.cast_rays(rays[::3]), scene.cast_rays(np.asfortranarray(other)[::3]))
+    same_answers(scene.cast_rays(rays, coherent=True), scene.cast_rays(other, coherent=True))
+    same_answers(scene.test_occlusions(rays, tfar=1.0), scene.test_occlusions(other, tfar=1.0))
+    same_answers(scene.count_intersections(rays), scene.count_intersections(other))
+    same_answers(scene.list_intersections(rays), scene.list_intersections(other))
+    points = rays[:, :3]
+    other_points = swapped(points, dtype)
+    same_answers(scene.compute_distance(points), scene.compute_distance(other_points))
+    same_answers(scene.compute_closest_points(points), scene.compute_closest_points(other_points))
+    same_answers(scene.compute_signed_distance(points, nsamples=3),
+                 scene.compute_signed_distance(other_points, nsamples=3))
+    same_answers(scene.compute_occupancy(points), scene.compute_occupancy(other_points))
+    # NaN points are found in the other byte order too.
+    bad = other_points.copy()
+    bad[7, 1] = np.nan
+    with pytest.raises(ValueError, match=r"compute_distance: query_points\[7\] has a NaN"):
+        scene.compute_distance(bad)
+
+
+@pytest.mark.parametrize("vdtype,tdtype", [(np.float32, np.uint32), (np.float64, np.int64)])
+@pytest.mark.parametrize("which", ["vertices", "triangles", "transforms", "updated vertices"])
+def test_non_native_byte_order_meshes_and_transforms(vdtype, tdtype, which):
+    """Vertices, triangle indices, transforms (4, 4) and (3, 4), and updated
+    vertices, each in turn in the other byte order, build the scene the
+    native arrays build."""
+    from meshes import icosphere
+    v, f = icosphere(2)
+    v = (v * np.array([1.0, 0.7, 1.3], np.float32) + np.float32(0.25)).astype(vdtype)
+    m = np.eye(4)
+    m[:3, :3] = [[0.0, -1.0, 0.0], [0.8, 0.0, 0.0], [0.0, 0.0, 1.5]]
+    m[:3, 3] = [3.0, -0.5, 0.25]
+    moved = np.eye(4)
+    moved[:3, 3] = [-3.0, 0.5, 0.0]
+    wobble = v * vdtype(1.1)
+    rng = np.random.default_rng(22)
+    o = rng.uniform(-5.0, 5.0, (2000, 3))
+    rays = np.concatenate([o, rng.uniform(-3.0, 3.0, (2000, 3)) - o], axis=1).astype(np.float32)
+    native = lambda a, t: np.asarray(a, t)
+    answers = []
+    for convert in (native, swapped):
+        def given(kind, a, t):
+            return (convert if kind == which else native)(a, t)
+        scene = rtcl.RaycastingScene()
+        assert scene.add_triangles(given("vertices", v, vdtype), given("triangles", f, tdtype)) == 0
+        flat = scene.cast_rays(rays)
+        points = scene.compute_closest_points(rays[:, :3])
+        scene.add_instance(0, given("transforms", m, vdtype))
+        scene.add_instance(0, given("transforms", np.c_[m[:3, :3], [0.0, 3.0, 0.0]], vdtype))  # (3, 4)
+        placed = scene.cast_rays(rays)
+        scene.set_transform(1, given("transforms", moved, vdtype))
+        scene.update_vertices(0, given("updated vertices", wobble, vdtype))
+        answers.append((flat, points, placed, scene.cast_rays(rays)))
+    for native_answer, other_answer in zip(*answers):
+        same_answers(native_answer, other_answer)
+    flat, _, placed, last = answers[0]
+    assert np.isfinite(flat["t_hit"]).sum() > 100
+    assert set(np.unique(placed["instance_ids"])) == {0, 1, INVALID}  # every placement is hit
+    assert set(np.unique(last["instance_ids"])) == {0, 1, INVALID}

@@ -8,11 +8,6 @@ import rtcl
 RS = rtcl.RaycastingScene
 
 
-@pytest.fixture(scope="module")
-def o3d():
-    return pytest.importorskip("open3d")
-
-
 def close(a, b):
     scale = np.maximum(1.0, np.abs(b))
     return np.max(np.abs(a - b) / scale) < 1e-5

@@ -55,10 +55,12 @@ def test_bunny_closest_hit(bunny_scene, bunny_camera, bunny_diffuse, which, cohe
 def test_bunny_occlusion_and_counts(bunny_scene, bunny_camera, bunny_diffuse, which):
     rays, ref = bunny_camera if which == "camera" else bunny_diffuse
     flat = rays.reshape(-1, 6)
-    occluded = bunny_scene.test_occlusions(rays)
-    assert occluded.dtype == np.bool_ and occluded.shape == rays.shape[:-1]
-    bad = ref.judge_any(occluded.reshape(-1))
-    assert len(bad) == 0, failures(bad, flat, "occlusion")
+    for coherent in (False, True):  # camera rays keep the promise, diffuse rays break it (still right)
+        occluded = bunny_scene.test_occlusions(rays, coherent=coherent)
+        assert occluded.dtype == np.bool_ and occluded.shape == rays.shape[:-1]
+        bad = ref.judge_any(occluded.reshape(-1))
+        assert len(bad) == 0, failures(bad, flat, f"occlusion, coherent={coherent}")
+        assert occluded.sum() > (0.3 if which == "camera" else 0.02) * occluded.size
     counts = bunny_scene.count_intersections(rays)
     assert counts.dtype == np.int32 and counts.shape == rays.shape[:-1]
     bad = ref.judge_count(counts.reshape(-1))
@@ -218,3 +220,48 @@ def test_several_meshes_report_their_ids():
     again = scene.cast_rays(rays)
     assert np.all(again["t_hit"][shift == 0.0] == 1.0)
     assert np.all(again["geometry_ids"][shift == 0.0] == 3)
+
+
+def test_every_hit_of_two_meshes_against_reference():
+    """list_intersections on a scene of two meshes (an icosphere, and a cube
+    behind it that the same rays cross): each crossing's geometry_ids,
+    primitive_ids, t_hit and primitive_uvs against the double-precision
+    brute force on the two meshes as one, where the ray is unambiguous."""
+    sphere, cube = icosphere(2), cube_grid(3)
+    cube = (cube[0] * np.float32(0.8) + np.array([3.0, 0.2, -0.1], np.float32), cube[1])
+    scene = rtcl.RaycastingScene()
+    assert scene.add_triangles(*sphere) == 0
+    assert scene.add_triangles(*cube) == 1
+    merged = Mesh(np.concatenate([sphere[0], cube[0]]),
+                  np.concatenate([sphere[1].astype(np.int64), cube[1].astype(np.int64) + len(sphere[0])]))
+    first_of = np.array([0, len(sphere[1])])  # merged triangle = first_of[geometry] + primitive
+    rng = np.random.default_rng(12)
+    n = 600
+    o = np.stack([np.full(n, -4.0), rng.uniform(-1.2, 1.2, n), rng.uniform(-1.2, 1.2, n)], axis=1)
+    target = np.stack([np.full(n, 5.0), rng.uniform(-1.0, 1.4, n), rng.uniform(-1.3, 1.1, n)], axis=1)
+    rays = np.concatenate([o, target - o], axis=1).astype(np.float32)
+    ref = RayReference(merged, with_bounds(rays))
+    every = scene.list_intersections(rays)
+    splits = every["ray_splits"].astype(np.int64)
+    assert every["geometry_ids"].dtype == np.uint32 and every["primitive_uvs"].dtype == np.float32
+    seen = set()
+    checked = 0
+    for r in np.nonzero(ref.unambiguous())[0]:
+        t_ref, tri_ref = ref.crossings(r)
+        lo, hi = splits[r], splits[r + 1]
+        assert hi - lo == len(t_ref), f"ray {r}: {hi - lo} crossings, reference {len(t_ref)}"
+        g = every["geometry_ids"][lo:hi].astype(np.int64)
+        assert np.all(g <= 1)
+        tri = first_of[g] + every["primitive_ids"][lo:hi]
+        # Sorted by t, the same triangles as the reference (a hit's t and
+        # uv are checked on its own triangle, so equal t in any order).
+        assert np.array_equal(np.sort(tri), np.sort(tri_ref)), f"ray {r}"
+        assert np.allclose(every["t_hit"][lo:hi], t_ref, rtol=0, atol=ref.t_tol[r])
+        o_r = np.repeat(ref.rays[r:r + 1, :3], hi - lo, axis=0)
+        d_r = np.repeat(ref.rays[r:r + 1, 3:6], hi - lo, axis=0)
+        u_ref, v_ref = merged.pair_uvs(o_r, d_r, tri)
+        uv = every["primitive_uvs"][lo:hi].astype(np.float64)
+        assert np.allclose(uv[:, 0], u_ref, atol=1e-5) and np.allclose(uv[:, 1], v_ref, atol=1e-5), f"ray {r}"
+        seen.update(g.tolist())
+        checked += hi - lo
+    assert seen == {0, 1} and checked > 1000

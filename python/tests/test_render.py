@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import rtcl
-from meshes import scenes_dir
+from meshes import mesh_file, scenes_dir
 
 
 def read_png(path):
@@ -78,8 +78,7 @@ def test_default_scene():
 ])
 def test_same_image_as_the_command(tmp_path, monkeypatch, options):
     if options["scene"] == "forest":
-        if not (scenes_dir() / "stanford_bunny" / "bunny.obj").is_file():
-            pytest.skip("the forest's bunny is not in RTCL_SCENES_DIR")
+        mesh_file("stanford_bunny/bunny.obj")  # the forest's bunny
         monkeypatch.setenv("RTCL_SCENES_DIR", str(scenes_dir()))
     out = tmp_path / "image.png"
     args = [os.environ["RTCL_CLI"], "render", "-q", "-o", str(out)]
@@ -137,10 +136,7 @@ def test_emissive_triangles_light_a_scene_without_lights(tmp_path):
     Cornell box's lamp, Ke = (17, 12, 4)) light the scene as the light
     {"type": "emissive"} whose intensity scales the brightest channel to 1
     would, with a note; without anything emitting, a warning."""
-    from meshes import scenes_dir
-    obj = scenes_dir() / "cornell_box" / "CornellBox-Original.obj"
-    if not obj.exists():
-        pytest.skip(f"{obj} not found (set RTCL_SCENES_DIR)")
+    obj = mesh_file("cornell_box/CornellBox-Original.obj")
     camera = '"camera": {"position": [0, 1, 3.9], "look_at": [0, 1, 0], "fov": 39.3}'
     objects = f'"objects": [{{"type": "mesh", "file": "{obj}"}}]'
     implicit, explicit = tmp_path / "implicit.json", tmp_path / "explicit.json"
