@@ -221,8 +221,12 @@ class Flattener {
     walks_.resize(1 + deferred.size());
     for_each_index(deferred.size(), threads_, [&](std::size_t k) {
       if (plan_by_part) plan_subtree(tree_, geometry_, deferred[k].todo.binary, plan_);
-      walks_[1 + k].nodes.emplace_back();
-      walk_from(deferred[k].todo, walks_[1 + k], nullptr, empty);
+      WalkOutput& part = walks_[1 + k];
+      part.nodes.emplace_back();
+      walk_from(deferred[k].todo, part, nullptr, empty);
+      // the sources stay until the gather: without the slack of their growth
+      part.triangle_sources.shrink_to_fit();
+      part.sphere_sources.shrink_to_fit();
     });
     assemble(deferred);
   }
@@ -300,7 +304,7 @@ class Flattener {
     for (std::size_t k = 0; k < deferred.size(); ++k)
       out_.nodes[deferred[k].parent].child[deferred[k].lane] = static_cast<rtcl_i32>(offsets[1 + k].nodes);
     for_each_index(deferred.size(), threads_, [&](std::size_t k) {
-      const WalkOutput& part = walks_[1 + k];
+      WalkOutput& part = walks_[1 + k];
       const Offsets& at = offsets[1 + k];
       const auto node_offset = static_cast<rtcl_i32>(at.nodes);
       const auto triangle_offset = static_cast<std::uint32_t>(at.triangles);
@@ -314,6 +318,7 @@ class Flattener {
             c = rebase_leaf(c, triangle_offset, sphere_offset);
         *to++ = node;
       }
+      std::vector<Bvh8Node>().swap(part.nodes);
     });
   }
 
