@@ -1,16 +1,19 @@
 // run_jobs (thread_pool.hpp): every job on a thread of its own at the same
 // time (jobs that wait for each other finish), nested calls, the lowest
-// job's exception, and a pool used again in a forked child.
+// job's exception, and a pool used again in a forked child; the loops and
+// reserve_faulted of parallel.hpp.
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <condition_variable>
 #include <csignal>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -86,6 +89,24 @@ TEST(ThreadPool, ForEachIndexVisitsEveryIndexOnce) {
   std::vector<std::atomic<int>> visits(1000);
   rtcl::for_each_index(visits.size(), 3, [&](std::size_t k) { ++visits[k]; });
   for (std::size_t k = 0; k < visits.size(); ++k) ASSERT_EQ(visits[k], 1) << k;
+}
+
+// reserve_faulted keeps the elements there are and makes room for n more
+// (its page writes fall in the room only), from a vector that is empty
+// and from one that is not.
+TEST(ThreadPool, ReserveFaultedKeepsTheElementsAndMakesRoom) {
+  std::vector<std::uint32_t> empty;
+  rtcl::reserve_faulted(empty, 3'000'000, 2);
+  EXPECT_TRUE(empty.empty());
+  EXPECT_GE(empty.capacity(), 3'000'000u);
+  std::vector<std::uint32_t> some = {7, 8, 9};
+  rtcl::reserve_faulted(some, 3'000'000, 2);
+  EXPECT_EQ(some, (std::vector<std::uint32_t>{7, 8, 9}));
+  EXPECT_GE(some.capacity(), 3'000'000u);
+  some.resize(3'000'000);
+  EXPECT_EQ(some[2], 9u);
+  EXPECT_EQ(some[3], 0u);
+  EXPECT_EQ(some.back(), 0u);
 }
 
 // Forked right after a call returns, while the parent's pool threads may

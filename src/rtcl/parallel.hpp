@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "rtcl/huge_pages.hpp"
 #include "rtcl/thread_pool.hpp"
 
 namespace rtcl {
@@ -53,6 +54,24 @@ void for_each_index(std::size_t count, unsigned threads, Fn&& fn) {
   });
   for (const std::exception_ptr& e : errors)
     if (e) std::rethrow_exception(e);
+}
+
+// Reserves room for n elements in v (advised for huge pages, as
+// reserve_advised) and faults in the pages of the room beyond v's elements
+// on up to `threads` threads, one write per 4 KiB, before any element
+// exists there: the resize that follows then writes mapped memory, where
+// it would otherwise take every page's first touch (the kernel zeroing the
+// page, on a virtual machine often much more) on the calling thread alone.
+template <class Vector>
+void reserve_faulted(Vector& v, std::size_t n, unsigned threads) {
+  reserve_advised(v, n);
+  constexpr std::size_t kPage = 4096;
+  auto* room = reinterpret_cast<volatile unsigned char*>(v.data() + v.size());
+  const std::size_t bytes = (v.capacity() - v.size()) * sizeof(typename Vector::value_type);
+  const std::size_t pages = (bytes + kPage - 1) / kPage;
+  for_each_part(pages, part_count(pages, threads, 256), [&](unsigned, std::size_t begin, std::size_t end) {
+    for (std::size_t page = begin; page < end; ++page) room[page * kPage] = 0;
+  });
 }
 
 }  // namespace rtcl

@@ -299,7 +299,7 @@ class Flattener {
     }
     if (end.nodes > 0x7fffffffu) fail("too many nodes");
     out_.nodes = std::move(walks_[0].nodes);
-    reserve_advised(out_.nodes, end.nodes);
+    reserve_faulted(out_.nodes, end.nodes, threads_);
     out_.nodes.resize(end.nodes);
     for (std::size_t k = 0; k < deferred.size(); ++k)
       out_.nodes[deferred[k].parent].child[deferred[k].lane] = static_cast<rtcl_i32>(offsets[1 + k].nodes);

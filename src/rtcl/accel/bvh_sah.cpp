@@ -214,7 +214,7 @@ class SahBuilder {
       add_task({root_subtree, root_, 1});
     run_jobs(thread_count_, [this](unsigned) { work(); });
     assemble(tree.nodes);
-    reserve_advised(tree.prims, ref_count_);
+    reserve_faulted(tree.prims, ref_count_, thread_count_);
     tree.prims.resize(ref_count_);
     for_each_part(ref_count_, part_count(ref_count_, thread_count_, config_.parallel_min_primitives),
                   [&](unsigned, std::size_t begin, std::size_t end) {
@@ -707,7 +707,7 @@ class SahBuilder {
       first[k] = static_cast<std::uint32_t>(total);
       total += subtrees_[k]->size();
     }
-    reserve_advised(out, total);
+    reserve_faulted(out, total, thread_count_);
     out.resize(total);
     for_each_index(subtrees_.size(), thread_count_, [&](std::size_t k) {
       BuildNode* to = out.data() + first[k];
