@@ -193,6 +193,9 @@ class Flattener {
   Bvh8 run() {
     if (tree_.empty()) fail("the build tree is empty");
     walk();
+    // what only the walk reads, freed before the gather's block array
+    plan_ = CollapsePlan();
+    std::vector<std::atomic<std::uint8_t>>().swap(node_seen_);
     gather();
     check_every_primitive_once();
     return std::move(out_);
