@@ -376,9 +376,11 @@ TEST(Scene, QueriesDuringCommitsSeeWholeCommits) {
   const std::vector<Ray> rays(64, Ray{0.25f, 0.25f, 1.0f, 0, 0, -1, 0, kInf});
   std::atomic<bool> stop{false};
   std::atomic<std::size_t> mixed{0}, calls{0};
+  std::atomic<int> started{0};
   std::vector<std::thread> readers;
   for (int r = 0; r < 3; ++r)
     readers.emplace_back([&] {
+      ++started;
       while (!stop) {
         std::vector<Hit> hits = scene.intersect(rays);
         for (const Hit& h : hits)
@@ -386,7 +388,11 @@ TEST(Scene, QueriesDuringCommitsSeeWholeCommits) {
         ++calls;
       }
     });
-  for (int k = 0; k < 40; ++k) {
+  // The commits start once every reader runs, and go on until the readers
+  // have made a few calls (a loaded machine can hold a new thread back for
+  // longer than 40 commits take).
+  while (started < 3) std::this_thread::yield();
+  for (int k = 0; k < 40 || (calls < 6 && k < 20000); ++k) {
     scene.set_transform(moving, Transform::translate(0, 0, k % 2 ? -2.0f : 0.0f));
     scene.commit();
   }
