@@ -452,7 +452,9 @@ class SahBuilder {
   }
 
   // Partitions the range by the split's plane; fills both sides' centre
-  // bounds (the boxes come from the bins). Both sides are non-empty.
+  // bounds, and with kBoxes (a sampled split: partition_with_boxes) their
+  // boxes, which otherwise come from the bins. Both sides are non-empty
+  // (each holds a binned reference).
   // Branch-free (Lomuto: each reference is swapped with the first of the
   // right side, which then grows by one unless it went left): which side a
   // reference goes to is unpredictable, and a branch on it mispredicted
@@ -529,7 +531,7 @@ class SahBuilder {
   std::uint32_t partition_halves(const Range& range, const Split& split, Range& left, Range& right) {
     const std::uint32_t mid = range.begin + (range.end - range.begin) / 2;
     const Range halves[2] = {{range.begin, mid, range.bounds, range.centres}, {mid, range.end, range.bounds, range.centres}};
-    Range sides[2][2] = {{left, right}, {left, right}};  // [half][left, right]: centre bounds only
+    Range sides[2][2] = {{left, right}, {left, right}};  // [half][left, right]: centre bounds (and boxes)
     std::uint32_t store[2] = {0, 0};
     for_each_part(2, thread_count_ > 1 ? 2u : 1u, [&](unsigned, std::size_t begin, std::size_t end) {
       for (std::size_t h = begin; h < end; ++h) store[h] = partition_any(halves[h], split, sides[h][0], sides[h][1]);
