@@ -4,6 +4,8 @@
 # tree; it defines
 #   RTCL_LIBRARY_SOURCES  every src/rtcl/*.cpp, plus the generated file below
 #   RTCL_LIBRARY_PCH      the headers most library files include (precompiled)
+# and the function rtcl_library_unity_build(<target>), which compiles a
+# target's library sources as unity batches;
 # copies the shared layouts to <binary dir>/include/rtcl/shared/ (internal
 # code includes each as <rtcl/shared/...>: put <binary dir>/include on the
 # include path), and adds the command that embeds the OpenCL kernels
@@ -24,6 +26,26 @@ list(APPEND RTCL_LIBRARY_SOURCES "${RTCL_EMBEDDED}")
 # library's files include, parsed once.
 set(RTCL_LIBRARY_PCH "${RTCL_ROOT}/include/rtcl/opencl.hpp" <glm/glm.hpp> <algorithm> <array> <chrono> <cmath>
                      <functional> <memory> <span> <string> <thread> <vector>)
+
+# Unity batches: the library's files compiled a batch at a time share the
+# parse of their headers and their template instantiations, which halves the
+# library's compile (each build compiles it: Release, sanitizers, fuzzing).
+# The files below stay out of the batches: each defines a file-local name
+# (anonymous namespace) that another library file defines too. The kernel
+# table stays out so that editing a kernel recompiles only it.
+set(RTCL_LIBRARY_UNITY_SKIP)
+foreach(name IN ITEMS
+    scene/scene_description.cpp render/ray_queue.cpp scene/scene_lights.cpp scene/two_level.cpp
+    beam/polygon2d.cpp accel/kdtree.cpp accel/kdtree_nodes.cpp query/closest_point.cpp scene/scene_bytes.cpp
+    accel/bsp.cpp accel/bvh_collapse.cpp io/temp_cleanup.cpp render/instanced_scene.cpp)
+  list(APPEND RTCL_LIBRARY_UNITY_SKIP "${RTCL_ROOT}/src/rtcl/${name}")
+endforeach()
+list(APPEND RTCL_LIBRARY_UNITY_SKIP "${RTCL_EMBEDDED}")
+function(rtcl_library_unity_build target)
+  set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 16)
+  set_source_files_properties(${RTCL_LIBRARY_UNITY_SKIP} TARGET_DIRECTORY ${target}
+                              PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+endfunction()
 
 file(GLOB RTCL_INTERNAL_SHARED_HEADERS CONFIGURE_DEPENDS "${RTCL_ROOT}/kernels/shared/*layouts.h"
      "${RTCL_ROOT}/kernels/shared/volumes.h" "${RTCL_ROOT}/kernels/shared/sampling.h")

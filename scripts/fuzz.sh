@@ -7,7 +7,7 @@
 # must then be added to tests/fuzz_regressions/<target>/ (replayed by ctest)
 # and fixed.
 #
-#   bash scripts/fuzz.sh --ci                      # every target, 30 s each (CI)
+#   bash scripts/fuzz.sh --ci                      # every target, 30 s each, two at a time (CI)
 #   bash scripts/fuzz.sh --seconds 3600 --jobs 2   # a longer campaign
 #   bash scripts/fuzz.sh --seconds 600 structures  # one target
 #
@@ -52,9 +52,11 @@ export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1:suppre
 # Leaks inside Assimp on its error paths are suppressed by library name (see
 # the file); a leak in rtcl's own code still fails the run.
 export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/scripts/sanitizers/lsan.supp:print_suppressions=0}"
-failed=()
-for target in "${targets[@]}"; do
-  corpus="build-fuzz/corpus/$target" artifacts="build-fuzz/artifacts/$target"
+# run_target <target>: fuzzes one target for $seconds; fails when it found
+# something (its input saved under build-fuzz/artifacts/<target>/).
+run_target() {
+  local target="$1"
+  local corpus="build-fuzz/corpus/$target" artifacts="build-fuzz/artifacts/$target"
   mkdir -p "$corpus" "$artifacts"
   # libFuzzer counts LLVMFuzzerInitialize into -max_total_time: the
   # structures target compiles its kernels first (minutes on a cold PoCL
@@ -62,16 +64,16 @@ for target in "${targets[@]}"; do
   if [ "$target" = structures ]; then
     echo "fuzz.sh: structures: compiling the kernels"
     "./build-fuzz/${target}_fuzz" fuzz/corpus/structures/tetrahedron_vertices_edges >"build-fuzz/$target.log" 2>&1 ||
-      { tail -n 60 "build-fuzz/$target.log" >&2; failed+=("$target"); continue; }
+      { tail -n 60 "build-fuzz/$target.log" >&2; return 1; }
   fi
   echo "fuzz.sh: $target for ${seconds} s"
   # A hang is an input over 10 s; the structures target's over 60 s: an input
   # whose scene selects a program option no earlier one did (a deeper BVH
   # stack, another set of bvh-mixed's filters) compiles that program first.
-  timeout=10
+  local timeout=10
   [ "$target" = structures ] && timeout=60
-  args=(-max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2048 -malloc_limit_mb=1024
-        -artifact_prefix="$artifacts/" -print_final_stats=1)
+  local args=(-max_total_time="$seconds" -timeout="$timeout" -rss_limit_mb=2048 -malloc_limit_mb=1024
+              -artifact_prefix="$artifacts/" -print_final_stats=1)
   [ "$jobs" -gt 1 ] && args+=(-fork="$jobs" -ignore_crashes=0)
   # CI's structures run is reproducible: one fixed seed, whose first 600 s
   # ran clean (a 30 s run reaches some 40 inputs); longer campaigns pick a
@@ -82,10 +84,26 @@ for target in "${targets[@]}"; do
        >"build-fuzz/$target.log" 2>&1; then
     tail -n 60 "build-fuzz/$target.log" >&2
     echo "fuzz.sh: $target FAILED; inputs in $artifacts/ (add them to tests/fuzz_regressions/$target/)" >&2
-    failed+=("$target")
-  else
-    grep -E "^(stat::number_of_executed_units|Done)" "build-fuzz/$target.log" || true
+    return 1
   fi
+  grep -E "^(stat::number_of_executed_units|Done)" "build-fuzz/$target.log" || true
+}
+
+# CI runs two targets at a time, one per core (each gets its 30 s of one
+# core); a campaign runs them one after the other, each with --jobs workers.
+at_once=1
+[ "$ci" -eq 1 ] && at_once=2
+failed=()
+for ((first = 0; first < ${#targets[@]}; first += at_once)); do
+  batch=("${targets[@]:first:at_once}")
+  pids=()
+  for target in "${batch[@]}"; do
+    run_target "$target" &
+    pids+=($!)
+  done
+  for k in "${!batch[@]}"; do
+    wait "${pids[k]}" || failed+=("${batch[k]}")
+  done
 done
 if [ ${#failed[@]} -gt 0 ]; then
   echo "fuzz.sh: failed: ${failed[*]}" >&2

@@ -549,7 +549,7 @@ TEST(Adversarial, OriginsOnASurface) {
 // of [tmin, tmax], or clearly farther. -1: clearly nothing; -2: ambiguous.
 class ClearAnswers {
  public:
-  explicit ClearAnswers(const Geometry& g) : g_(g) {
+  explicit ClearAnswers(const Geometry& g) : g_(g), bounds_(g.bounds()) {
     for (std::size_t p = 0; p < g.primitive_count(); ++p) {
       Aabb b = g.primitive_bounds(p);
       centers_.push_back(glm::dvec3(b.center()));
@@ -558,7 +558,7 @@ class ClearAnswers {
   }
 
   int closest(const Ray& ray) const {
-    Tolerance tol = tolerance_for(g_, ray);
+    Tolerance tol = tolerance_in(bounds_, ray);
     Hit best = reference_closest(g_, ray);
     double best_t = best.prim >= 0 ? best.t : std::numeric_limits<double>::infinity();
     glm::dvec3 o(ray.ox, ray.oy, ray.oz), d = glm::normalize(glm::dvec3(ray.dx, ray.dy, ray.dz));
@@ -567,7 +567,7 @@ class ClearAnswers {
       glm::dvec3 to_center = centers_[p] - o;
       double line_distance = glm::length(to_center - glm::dot(to_center, d) * d);
       if (line_distance > radii_[p] + tol.space) continue;  // the line misses its bounding sphere
-      PrimHit h = reference_intersect(g_, p, ray);
+      PrimHit h = reference_intersect(g_, p, ray, tol);
       if (!h.plane || h.margin < -tol.space) continue;
       if (h.t < ray.tmin - tol.t || h.t > ray.tmax + tol.t || h.t > best_t + tol.t) continue;
       return -2;
@@ -577,6 +577,7 @@ class ClearAnswers {
 
  private:
   const Geometry& g_;
+  Aabb bounds_;
   std::vector<glm::dvec3> centers_;
   std::vector<double> radii_;
 };
