@@ -2,6 +2,7 @@
 #include "rtcl/accel/structure_kernels.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cfloat>
 #include <chrono>
 #include <cmath>
@@ -208,7 +209,9 @@ FlattenOptions flatten_options(const BvhConfig& config) {
           .greedy_levels = config.greedy_levels};
 }
 
-std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size) { return std::max(8u, (stack_size + 7u) / 8u * 8u); }
+std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size) {
+  return std::max<std::uint32_t>(64, std::bit_ceil(stack_size));
+}
 
 AccelStats bvh_stats(const Geometry& geometry, const GeometryReport& report, const Bvh8& bvh,
                      std::chrono::steady_clock::time_point start) {
