@@ -2,7 +2,6 @@
 #include "rtcl/accel/structure_kernels.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cfloat>
 #include <chrono>
 #include <cmath>
@@ -210,7 +209,7 @@ FlattenOptions flatten_options(const BvhConfig& config) {
 }
 
 std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size) {
-  return std::max<std::uint32_t>(64, std::bit_ceil(stack_size));
+  return std::max(32u, (stack_size + 7u) / 8u * 8u);
 }
 
 AccelStats bvh_stats(const Geometry& geometry, const GeometryReport& report, const Bvh8& bvh,

@@ -143,9 +143,9 @@ unsigned bvh_thread_count(const BvhConfig& config);
 inline constexpr std::uint32_t kBvhMaxStackSize = 1024;
 
 // The RTCL_STACK_SIZE the kernel is compiled with for a tree needing
-// `stack_size` entries: a power of two, at least 64, so that most trees
+// `stack_size` entries: a multiple of 8, at least 32, so that small trees
 // share one compiled program (a program's compile costs about a second on
-// PoCL; the unused entries cost nothing).
+// PoCL) while a large tree keeps its own tight stack.
 std::uint32_t bvh_kernel_stack_size(std::uint32_t stack_size);
 
 // Builds, flattens and uploads; stats().build_ms covers build + flatten.
