@@ -28,8 +28,9 @@ set(RTCL_LIBRARY_PCH "${RTCL_ROOT}/include/rtcl/opencl.hpp" <glm/glm.hpp> <algor
                      <functional> <memory> <span> <string> <thread> <vector>)
 
 # Unity batches: the library's files compiled a batch at a time share the
-# parse of their headers and their template instantiations, which halves the
-# library's compile (each build compiles it: Release, sanitizers, fuzzing).
+# parse of their headers and their template instantiations, which shortens
+# the library's compile in each build that compiles it (Release, sanitizers,
+# fuzzing; docs/benchmarks.md, "CI time").
 # The files below stay out of the batches: each defines a file-local name
 # (anonymous namespace) that another library file defines too. The kernel
 # table stays out so that editing a kernel recompiles only it.
