@@ -32,12 +32,9 @@ namespace rtcl::test {
 namespace {
 
 using everywhere::describe;
-using everywhere::make_ray;
 using everywhere::query_name;
 using everywhere::run_everywhere;
 using everywhere::RunOptions;
-constexpr float kInf = everywhere::kInf;
-constexpr float kNaN = everywhere::kNaN;
 
 // True when the triangle contains the point where the ray meets its plane
 // (closed triangle, edges and vertices included, in double precision).

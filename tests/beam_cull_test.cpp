@@ -34,7 +34,7 @@ using glm::dvec2;
 using glm::dvec3;
 using glm::dvec4;
 
-struct World {
+struct VirtualWorld {
   const char* name;
   glm::dmat4 to_virtual;
   bool clipped;
@@ -53,10 +53,10 @@ beam::Convex random_section(std::mt19937& rng, double w, double h) {
 // Checks the cull against the exact candidates of `sections` beams in each
 // world; returns (culled, exact) totals.
 std::pair<std::size_t, std::size_t> check_cull(const Geometry& g, const beam::ScreenSpace& screen,
-                                               const std::vector<World>& worlds, std::mt19937& rng, int sections) {
+                                               const std::vector<VirtualWorld>& worlds, std::mt19937& rng, int sections) {
   BuildTree bvh = build_binary_bvh(g);
   std::size_t culled_total = 0, exact_total = 0;
-  for (const World& w : worlds)
+  for (const VirtualWorld& w : worlds)
     for (int i = 0; i < sections; ++i) {
       beam::Convex section = random_section(rng, screen.width, screen.height);
       std::vector<std::uint32_t> culled;
@@ -77,7 +77,7 @@ std::pair<std::size_t, std::size_t> check_cull(const Geometry& g, const beam::Sc
   return {culled_total, exact_total};
 }
 
-std::vector<World> worlds_of(const beam::ScreenSpace& screen, const Geometry& g, std::uint32_t mirror_prim,
+std::vector<VirtualWorld> worlds_of(const beam::ScreenSpace& screen, const Geometry& g, std::uint32_t mirror_prim,
                              std::uint32_t glass_prim) {
   auto plane = [&](std::uint32_t t) {
     return beam::plane_through(dvec3(g.vertices[g.triangles[t].x]), dvec3(g.vertices[g.triangles[t].y]),

@@ -22,7 +22,6 @@
 namespace rtcl::test {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // Every triangle vertex below child reference `ref`, read back from the
 // blocks (the leaves' contents).
@@ -37,8 +36,6 @@ void vertices_below(const Bvh8& bvh, rtcl_i32 ref, std::vector<glm::dvec3>& out)
     if (b.prim[lane] >= 0)
       for (int v = 0; v < 3; ++v) out.emplace_back(b.v[v][0][lane], b.v[v][1][lane], b.v[v][2][lane]);
 }
-
-Geometry bunny() { return load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry; }
 
 // Specs with one kind free (cost 0: wherever it cuts the box) and the others
 // off, and all kinds free (each node takes the one that cuts most).

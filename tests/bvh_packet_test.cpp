@@ -26,8 +26,6 @@
 namespace rtcl::test {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // Pinhole camera rays, row-major, looking at the geometry from +z.
 std::vector<Ray> camera_rays(const Geometry& g, std::uint32_t width, std::uint32_t height) {
@@ -85,12 +83,6 @@ void expect_same_as_single_ray(const Accel& single, const Accel& packet, const s
     EXPECT_EQ(differ, 0u) << what << (q == Query::closest ? " closest" : " any") << ": first at ray " << first
                           << " of " << rays.size();
   }
-}
-
-Geometry bunny() {
-  Geometry g = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
-  validate(g);
-  return g;
 }
 
 TEST(BvhPacket, IsRegistered) {

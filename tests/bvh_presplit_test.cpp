@@ -137,16 +137,16 @@ TEST(Presplit, AnswersAsBruteForceAlsoAlongSplitPlanes) {
   for (int i = -8; i <= 16; ++i)
     for (int k = -8; k <= 16; ++k) {
       const float x = i / 8.0f, z = k / 8.0f;
-      rays.push_back(everywhere::make_ray({x, 3, z}, {0, -1, 0}));
-      rays.push_back(everywhere::make_ray({x, 3, z}, {-0.0f, -1, 0.0f}));
-      rays.push_back(everywhere::make_ray({x, -0.5f, z}, {0.25f, 1, 0}));
+      rays.push_back(make_ray({x, 3, z}, {0, -1, 0}));
+      rays.push_back(make_ray({x, 3, z}, {-0.0f, -1, 0.0f}));
+      rays.push_back(make_ray({x, -0.5f, z}, {0.25f, 1, 0}));
     }
   // In the plane x = 0.5 and z = 0.5, along the floor's surface and across it.
   for (int k = -16; k <= 32; ++k) {
     const float s = k / 16.0f;
-    rays.push_back(everywhere::make_ray({0.5f, 1, s}, {0, -1, 0.001f}));
-    rays.push_back(everywhere::make_ray({s, 1, 0.5f}, {0.001f, -1, 0}));
-    rays.push_back(everywhere::make_ray({-2, 0, s}, {1, 0, 0}));
+    rays.push_back(make_ray({0.5f, 1, s}, {0, -1, 0.001f}));
+    rays.push_back(make_ray({s, 1, 0.5f}, {0.001f, -1, 0}));
+    rays.push_back(make_ray({-2, 0, s}, {1, 0, 0}));
   }
   const Device& device = test_device();
   auto brute = make_accel(device, "brute", g);

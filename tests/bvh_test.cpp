@@ -20,7 +20,6 @@
 namespace rtcl::test {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
 const char* builder_name(BvhBuilder b) { return b == BvhBuilder::sah ? "sah" : "ploc"; }
 
@@ -34,12 +33,12 @@ const char* accel_for(BvhBuilder b) { return b == BvhBuilder::sah ? "bvh" : "bvh
 
 // The builder inputs build_binary_bvh derives: stored primitives with their
 // boxes (spheres widened as the BVH widens them, so compare loosely).
-struct Inputs {
+struct BuildInputs {
   std::vector<Aabb> bounds;
   std::vector<std::uint32_t> ids;
 };
-Inputs triangle_inputs(const Geometry& g) {
-  Inputs in;
+BuildInputs triangle_inputs(const Geometry& g) {
+  BuildInputs in;
   for (std::uint32_t p : stored_primitives(g))
     if (p < g.triangles.size()) {
       in.bounds.push_back(g.primitive_bounds(p));
@@ -48,7 +47,7 @@ Inputs triangle_inputs(const Geometry& g) {
   return in;
 }
 
-BuildTree build_with(BvhBuilder b, const Inputs& in) {
+BuildTree build_with(BvhBuilder b, const BuildInputs& in) {
   return b == BvhBuilder::sah ? build_sah(in.bounds, in.ids) : build_ploc(in.bounds, in.ids);
 }
 
@@ -184,7 +183,7 @@ INSTANTIATE_TEST_SUITE_P(Bvh, BvhBuilders, ::testing::Values(BvhBuilder::sah, Bv
 
 TEST_P(BvhBuilders, TreeHoldsEveryPrimitiveOnceInSmallLeaves) {
   Geometry g = random_soup(5000, 11);
-  Inputs in = triangle_inputs(g);
+  BuildInputs in = triangle_inputs(g);
   BuildTree tree = build_with(GetParam(), in);
   EXPECT_EQ(check(tree, in.bounds, in.ids, 8), "");
   EXPECT_EQ(tree.prims.size(), in.ids.size());
@@ -225,7 +224,7 @@ TEST_P(BvhBuilders, DegenerateInputsGiveValidShallowTrees) {
   cases.push_back({"identical triangles", identical_triangles(100000), 20});
   for (Case& c : cases) {
     SCOPED_TRACE(c.what);
-    Inputs in = triangle_inputs(c.g);
+    BuildInputs in = triangle_inputs(c.g);
     BuildTree tree = build_with(GetParam(), in);
     EXPECT_EQ(check(tree, in.bounds, in.ids, 8), "");
     EXPECT_LE(tree.depth(), c.max_depth);
@@ -343,7 +342,7 @@ void canonical(const BuildTree& tree, std::uint32_t n, std::vector<double>& out)
 // (at 16384 references and more) give the tree of the one-thread build.
 TEST(Bvh, SahTreeDoesNotDependOnTheThreads) {
   Geometry g = random_soup(60000, 5);
-  Inputs in = triangle_inputs(g);
+  BuildInputs in = triangle_inputs(g);
   std::vector<double> one, many;
   canonical(build_sah(in.bounds, in.ids, {.thread_count = 1}), 0, one);
   for (unsigned threads : {2u, 4u}) {
@@ -358,7 +357,7 @@ TEST(Bvh, SahTreeDoesNotDependOnTheThreads) {
 // Every node's box is the union of its children's (inner) or of its
 // primitives' boxes (leaf), exactly: "" when so, else the first node that
 // is not.
-std::string check_tight(const BuildTree& tree, const Inputs& in) {
+std::string check_tight(const BuildTree& tree, const BuildInputs& in) {
   std::unordered_map<std::uint32_t, std::size_t> position;
   for (std::size_t i = 0; i < in.ids.size(); ++i) position[in.ids[i]] = i;
   for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
@@ -382,7 +381,7 @@ std::string check_tight(const BuildTree& tree, const Inputs& in) {
 // references down).
 TEST(Bvh, SampledBinningKeepsExactBoxesAndTheCost) {
   Geometry g = random_soup(30000, 11);
-  Inputs in = triangle_inputs(g);
+  BuildInputs in = triangle_inputs(g);
   std::vector<double> one, many;
   const BuildTree tree = build_sah(in.bounds, in.ids, {.binning_samples = 1024, .thread_count = 1});
   EXPECT_EQ(check(tree, in.bounds, in.ids, 8), "");
@@ -518,7 +517,7 @@ TEST(Bvh, SahBuilderNamesTheFirstBadBoxOnEveryThread) {
 TEST(Bvh, SahOverFilledReferencesBuildsTheTreeOfTheBoxes) {
   Geometry g = random_soup(40000, 31);
   for (std::size_t i = 3; i < g.triangles.size(); i += 7) g.triangles[i].z = g.triangles[i].y;
-  const Inputs in = triangle_inputs(g);
+  const BuildInputs in = triangle_inputs(g);
   ASSERT_LT(in.ids.size(), g.triangles.size() - g.triangles.size() / 8);
   for (unsigned threads : {1u, 2u}) {
     BvhConfig config;

@@ -15,13 +15,13 @@ namespace rtcl::test {
 namespace {
 
 // A unit cube's corners plus one vertex at (2, 0.5, 0.5): AABB [0, 2] x [0, 1]^2.
-const char* const cube_obj =
+const char* const cube_and_wedge_obj =
     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nv 2 0.5 0.5\n"
     "f 1 2 3 4\nf 5 6 7 8\nf 1 2 6 5\nf 4 3 7 8\nf 2 9 3\nf 6 9 7\n";
 
 TEST(CliBounds, PrintsEveryVolume) {
   TempDir dir;
-  std::string mesh = dir.write("cube.obj", cube_obj);
+  std::string mesh = dir.write("cube.obj", cube_and_wedge_obj);
   CliRun run = run_cli(dir, {"bounds", mesh});
   ASSERT_EQ(run.status, 0) << run.err;
   for (const char* name : {"aabb", "obb", "kdop4", "kdop7", "kdop9", "kdop13", "ritter", "iterated", "exact", "axis 2"})
@@ -30,7 +30,7 @@ TEST(CliBounds, PrintsEveryVolume) {
 
 TEST(CliBounds, JsonAgreesWithTheVertices) {
   TempDir dir;
-  std::string mesh = dir.write("cube.obj", cube_obj);
+  std::string mesh = dir.write("cube.obj", cube_and_wedge_obj);
   CliRun run = run_cli(dir, {"bounds", mesh, "--json"});
   ASSERT_EQ(run.status, 0) << run.err;
   nlohmann::json j = nlohmann::json::parse(run.out);

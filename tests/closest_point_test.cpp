@@ -29,8 +29,6 @@
 namespace rtcl::test {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 // The structures that answer closest-point queries.
 const std::vector<std::string> kFamily{"bvh", "bvh-ploc", "bvh-packet"};

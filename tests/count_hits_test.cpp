@@ -30,15 +30,12 @@ namespace rtcl::test {
 namespace {
 
 using everywhere::describe;
-using everywhere::make_ray;
-constexpr float kInf = everywhere::kInf;
-constexpr float kNaN = everywhere::kNaN;
 
 const std::vector<std::string> kSupported = {"bvh", "bvh-ploc", "bvh-packet"};
 
 // Sets an environment variable for one scope.
 // Every vertex and every edge midpoint (rounded to float) of a mesh.
-std::vector<glm::vec3> vertices_and_edge_midpoints(const Geometry& mesh) {
+std::vector<glm::vec3> corners_and_edge_midpoints(const Geometry& mesh) {
   std::vector<glm::vec3> points(mesh.vertices.begin(), mesh.vertices.end());
   for (auto [a, b] : unique_edges(mesh)) points.push_back(0.5f * (mesh.vertices[a] + mesh.vertices[b]));
   return points;
@@ -142,7 +139,7 @@ TEST(CountHits, EveryPrecisionLevelGivesTheSameAnswers) {
   Geometry soup = random_soup(2000, 4, 0.15f);
   Geometry cube = cube_grid(4);
   std::vector<Ray> soup_rays = random_rays(soup, 2000, 9), cube_rays;
-  for (const glm::vec3& p : vertices_and_edge_midpoints(cube)) cube_rays.push_back(make_ray(glm::vec3(0.1f), p));
+  for (const glm::vec3& p : corners_and_edge_midpoints(cube)) cube_rays.push_back(make_ray(glm::vec3(0.1f), p));
   for (const auto& [g, rays] : {std::make_pair(&soup, &soup_rays), std::make_pair(&cube, &cube_rays)}) {
     std::vector<std::uint32_t> base;
     AllHits base_all;
@@ -165,13 +162,13 @@ TEST(CountHits, EveryPrecisionLevelGivesTheSameAnswers) {
   }
 }
 
-struct ClosedMesh {
+struct NamedClosedMesh {
   const char* name;
   Geometry mesh;
   bool convex;  // (all are star-shaped from the origin)
 };
 
-std::vector<ClosedMesh> closed_meshes() {
+std::vector<NamedClosedMesh> named_closed_meshes() {
   return {{"icosphere", icosphere(2), true},
           {"uv sphere", uv_sphere(8, 16), true},
           {"cube grid", cube_grid(4), true},
@@ -182,10 +179,10 @@ std::vector<ClosedMesh> closed_meshes() {
 // centre (every mesh is star-shaped from it), twice through the mesh from
 // outside (convex ones), the same with +0 and -0 direction components.
 TEST(CountHits, ARayThroughASharedEdgeOrVertexCrossesOnce) {
-  for (const ClosedMesh& c : closed_meshes()) {
+  for (const NamedClosedMesh& c : named_closed_meshes()) {
     ASSERT_EQ(open_edges(c.mesh), 0u) << c.name;
     std::vector<Ray> from_centre, through;
-    for (const glm::vec3& p : vertices_and_edge_midpoints(c.mesh)) {
+    for (const glm::vec3& p : corners_and_edge_midpoints(c.mesh)) {
       from_centre.push_back(make_ray(glm::vec3(0.0f), p));
       // the same with each zero component negated
       glm::vec3 flipped(p.x == 0.0f ? -0.0f : p.x, p.y == 0.0f ? -0.0f : p.y, p.z == 0.0f ? -0.0f : p.z);
@@ -216,7 +213,7 @@ TEST(CountHits, ARayThroughASharedEdgeOrVertexCrossesOnce) {
 // line, in a face's plane (axis-parallel ones on the cube, exactly in it;
 // the face itself has zero projected area and is never hit): 0 or 2.
 TEST(CountHits, SilhouetteTouchesAndInPlaneRaysCountZeroOrTwo) {
-  for (const ClosedMesh& c : closed_meshes()) {
+  for (const NamedClosedMesh& c : named_closed_meshes()) {
     if (!c.convex) continue;
     std::vector<Ray> rays;
     for (const glm::vec3& v : c.mesh.vertices) {
@@ -286,9 +283,9 @@ TEST(CountHits, ParityOfTheCountTellsInsideFromOutside) {
   // and through the vertices and edge midpoints of the closed meshes from
   // points inside and outside
   std::vector<std::pair<Geometry, std::vector<Ray>>> meshes;
-  for (const ClosedMesh& c : closed_meshes()) {
+  for (const NamedClosedMesh& c : named_closed_meshes()) {
     std::vector<Ray> mesh_rays;
-    for (const glm::vec3& p : vertices_and_edge_midpoints(c.mesh)) {
+    for (const glm::vec3& p : corners_and_edge_midpoints(c.mesh)) {
       mesh_rays.push_back(make_ray({0.1f, -0.2f, 0.15f}, p - glm::vec3(0.1f, -0.2f, 0.15f)));
       mesh_rays.push_back(make_ray({2.5f, 1.5f, -2.0f}, p - glm::vec3(2.5f, 1.5f, -2.0f)));
     }

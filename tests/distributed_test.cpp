@@ -36,15 +36,15 @@ RenderSettings settings(std::uint32_t size, std::uint32_t spp, Sampler sampler =
   return s;
 }
 
-// The thresholds of render_test.cpp's expect_matches_reference: pixels whose
+// The thresholds of render_test.cpp's expect_image_matches_reference: pixels whose
 // ray tree is stable under a 0.01-pixel move differ by float rounding only
 // (1e-3, amplified by Phong exponents); at most 2% of the pixels (edges,
 // shadow and lobe boundaries, where float and double may pick the other
 // side) differ by more than 0.05.
-constexpr double max_unambiguous_error = 1e-3;
-constexpr double max_fraction_over = 0.02;
+constexpr double max_unambiguous_pixel_error = 1e-3;
+constexpr double max_fraction_of_pixels_over = 0.02;
 
-ImageDifference expect_matches_reference(const SceneDescription& scene, const RenderSettings& s, const std::string& what,
+ImageDifference expect_image_matches_reference(const SceneDescription& scene, const RenderSettings& s, const std::string& what,
                                          const std::string& accel = "bvh") {
   ReferenceImage ref = reference_render(scene, s);
   Renderer renderer(test_device(), scene, accel);
@@ -52,8 +52,8 @@ ImageDifference expect_matches_reference(const SceneDescription& scene, const Re
   double pixels = double(s.width) * s.height;
   std::printf("[ measure  ] %s: rmse %.5f, max unambiguous %.2e, ambiguous %zu, over 0.05: %zu of %.0f\n", what.c_str(),
               d.rmse, d.max_error_unmasked, d.masked_pixels, d.pixels_over, pixels);
-  EXPECT_LE(d.max_error_unmasked, max_unambiguous_error) << what;
-  EXPECT_LE(d.pixels_over, max_fraction_over * pixels) << what;
+  EXPECT_LE(d.max_error_unmasked, max_unambiguous_pixel_error) << what;
+  EXPECT_LE(d.pixels_over, max_fraction_of_pixels_over * pixels) << what;
   EXPECT_LT(d.masked_pixels, 0.5 * pixels) << what << ": the ambiguity test must leave most pixels checked";
   return d;
 }
@@ -87,16 +87,12 @@ SceneDescription with_lens(float aperture, float focus) {
   return s;
 }
 
-bool has(const std::vector<std::string>& defines, const std::string& d) {
-  return std::find(defines.begin(), defines.end(), d) != defines.end();
-}
-
 TEST(Distributed, EverySamplerAndFilterMatchesTheReference) {
   for (Sampler sampler : {Sampler::stratified, Sampler::random, Sampler::sobol})
     for (Filter filter : {Filter::box, Filter::gaussian}) {
       RenderSettings s = settings(24, 4, sampler);
       s.filter = filter;
-      expect_matches_reference(default_scene(), s,
+      expect_image_matches_reference(default_scene(), s,
                                "default scene, " + std::string(sampler_name(sampler)) + ", " +
                                    std::string(filter_name(filter)));
     }
@@ -108,7 +104,7 @@ TEST(Distributed, SoftShadowsOfQuadDiscAndSphereLightsMatchTheReference) {
       SceneDescription scene = with_area_light(shape, 0.5f);
       Renderer renderer(test_device(), scene, "brute");
       EXPECT_TRUE(has(renderer.defines(), "RTCL_HAS_AREA_LIGHTS"));
-      expect_matches_reference(scene, settings(24, 2, sampler, 3),
+      expect_image_matches_reference(scene, settings(24, 2, sampler, 3),
                                "area light " + std::to_string(int(shape)) + ", " + std::string(sampler_name(sampler)));
     }
 }
@@ -126,7 +122,7 @@ TEST(Distributed, EmissiveTrianglesOfTheCornellBoxAreAreaLights) {
   // area shares: the two halves of the lamp together carry its emission
   glm::vec3 total = expanded[0].color + expanded[1].color;
   EXPECT_NEAR(total.x, 17.0f, 1e-4f);
-  expect_matches_reference(scene, settings(24, 2, Sampler::sobol, 2), "cornell box, emissive lamp");
+  expect_image_matches_reference(scene, settings(24, 2, Sampler::sobol, 2), "cornell box, emissive lamp");
 
   SceneDescription dark = default_scene();
   for (Material& m : dark.materials) m.emission = glm::vec3(0.0f);
@@ -151,8 +147,8 @@ TEST(Distributed, AnAreaLightOfSizeZeroIsThePointLight) {
   for (LightShape shape : {LightShape::quad, LightShape::disc, LightShape::sphere}) {
     Image area = Renderer(test_device(), with_area_light(shape, 0.0f), "bvh").render(s);
     ImageDifference d = compare_images(area, ref.image, ref.ambiguous);
-    EXPECT_LE(d.max_error_unmasked, max_unambiguous_error) << int(shape);
-    EXPECT_LE(d.pixels_over, max_fraction_over * 32 * 32) << int(shape);
+    EXPECT_LE(d.max_error_unmasked, max_unambiguous_pixel_error) << int(shape);
+    EXPECT_LE(d.pixels_over, max_fraction_of_pixels_over * 32 * 32) << int(shape);
     ImageDifference same = compare_images(area, point_image);
     EXPECT_LE(same.max_error, 1e-5) << int(shape) << ": four shares of a point light";
   }
@@ -162,7 +158,7 @@ TEST(Distributed, ThinLensMatchesTheReference) {
   SceneDescription scene = with_lens(0.08f, 3.0f);
   EXPECT_TRUE(has(Renderer(test_device(), scene, "brute").defines(), "RTCL_HAS_SPHERES"));
   for (Sampler sampler : {Sampler::stratified, Sampler::sobol})
-    expect_matches_reference(scene, settings(24, 4, sampler), "thin lens, " + std::string(sampler_name(sampler)));
+    expect_image_matches_reference(scene, settings(24, 4, sampler), "thin lens, " + std::string(sampler_name(sampler)));
 }
 
 // A zero aperture compiles no lens code and renders the pinhole image; a
@@ -176,15 +172,15 @@ TEST(Distributed, ZeroApertureIsThePinhole) {
   // 1e-7 of the 4-unit scene: the lens moves rays by a thousandth of the 0.01-pixel ambiguity test
   ImageDifference d = compare_images(Renderer(test_device(), with_lens(4e-7f, 3.0f), "bvh").render(s), ref.image,
                                      ref.ambiguous);
-  EXPECT_LE(d.max_error_unmasked, max_unambiguous_error);
-  EXPECT_LE(d.pixels_over, max_fraction_over * 32 * 32);
+  EXPECT_LE(d.max_error_unmasked, max_unambiguous_pixel_error);
+  EXPECT_LE(d.pixels_over, max_fraction_of_pixels_over * 32 * 32);
 }
 
 TEST(Distributed, GlossyReflectionMatchesTheReference) {
   SceneDescription scene = with_glossy_mirror(0.2f);
   EXPECT_TRUE(has(Renderer(test_device(), scene, "brute").defines(), "RTCL_HAS_GLOSSY"));
   for (Sampler sampler : {Sampler::random, Sampler::sobol})
-    expect_matches_reference(scene, settings(24, 4, sampler), "glossy mirror, " + std::string(sampler_name(sampler)));
+    expect_image_matches_reference(scene, settings(24, 4, sampler), "glossy mirror, " + std::string(sampler_name(sampler)));
 }
 
 TEST(Distributed, KernelsCompileOnlyTheEffectsTheSceneHas) {

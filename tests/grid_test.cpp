@@ -23,11 +23,7 @@
 namespace rtcl::test {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
 
-Ray make_ray(glm::vec3 o, glm::vec3 d, float tmin = 0.0f, float tmax = kInf) {
-  return {o.x, o.y, o.z, d.x, d.y, d.z, tmin, tmax};
-}
 
 const Precision kLevels[] = {Precision::fast, Precision::robust, Precision::exact};
 
@@ -89,7 +85,7 @@ std::vector<Ray> cell_boundary_rays(const Grid& grid, std::uint32_t seed, std::s
 // -cl-fast-relaxed-math may round differently in the two programs), for
 // any hit the same hit / miss. At the robust level the closest hits are
 // also judged against the double-precision reference.
-void expect_same_as_brute(const Geometry& g, const std::vector<Ray>& rays, const GridConfig& config,
+void expect_grid_same_as_brute(const Geometry& g, const std::vector<Ray>& rays, const GridConfig& config,
                           Precision level, bool judge = true) {
   AccelConfig accel_config{level};
   auto brute = make_brute(test_device(), g, accel_config);
@@ -333,7 +329,7 @@ TEST(GridBuild, BadConfigAndDeviceLimitsAreErrorsNamingTheOption) {
 TEST(GridTrace, MatchesBruteForceOnSoupsAtEveryLevel) {
   Geometry g = soup_with_spheres(2000, 11);
   std::vector<Ray> rays = random_rays(g, 1500, 12);
-  for (Precision level : kLevels) expect_same_as_brute(g, rays, {}, level);
+  for (Precision level : kLevels) expect_grid_same_as_brute(g, rays, {}, level);
 }
 
 TEST(GridTrace, MatchesBruteForceOnCellBoundaryRays) {
@@ -342,7 +338,7 @@ TEST(GridTrace, MatchesBruteForceOnCellBoundaryRays) {
                              GridResolution{96, 96, 96}}) {
     GridConfig config = with_res(res[0], res[1], res[2]);
     std::vector<Ray> rays = cell_boundary_rays(build_grid(g, config), 22, 3000);
-    for (Precision level : kLevels) expect_same_as_brute(g, rays, config, level);
+    for (Precision level : kLevels) expect_grid_same_as_brute(g, rays, config, level);
   }
 }
 
@@ -367,7 +363,7 @@ TEST(GridTrace, EveryMacrocellSizeMatchesBruteForceOnASparseScene) {
     GridConfig config = with_res(40, 24, 32);
     config.macro = macro;
     std::vector<Ray> rays = cell_boundary_rays(build_grid(g, config), 42 + macro, 3000);
-    for (Precision level : {Precision::robust, Precision::exact}) expect_same_as_brute(g, rays, config, level);
+    for (Precision level : {Precision::robust, Precision::exact}) expect_grid_same_as_brute(g, rays, config, level);
   }
 }
 
@@ -392,7 +388,7 @@ TEST(GridTrace, DyadicSceneRaysOnCellPlanesAndCorners) {
       rays.push_back(make_ray({0.5f, float(y), float(z)}, {1, 0, 0}));  // starts on a surface, on a cell plane
       rays.push_back(make_ray({1.0f, float(y), float(z)}, {1, 1, 1}));  // from a grid corner
     }
-  for (Precision level : kLevels) expect_same_as_brute(g, rays, config, level);
+  for (Precision level : kLevels) expect_grid_same_as_brute(g, rays, config, level);
 }
 
 TEST(GridTrace, FlatSceneSingleTriangleAndTinyIntervals) {
@@ -407,15 +403,15 @@ TEST(GridTrace, FlatSceneSingleTriangleAndTinyIntervals) {
   rays.push_back(make_ray({0.25f, 0.25f, 0.0f}, {0, 0, 1}, 0.0f, 1.0f));  // tmax exactly at the hit
   rays.push_back(make_ray({0.25f, 0.25f, 0.0f}, {0, 0, 1}, 0.0f, std::nextafter(1.0f, 0.0f)));
   for (Precision level : kLevels) {
-    expect_same_as_brute(one, rays, {}, level);
-    expect_same_as_brute(one, rays, with_res(1, 1, 1), level);
+    expect_grid_same_as_brute(one, rays, {}, level);
+    expect_grid_same_as_brute(one, rays, with_res(1, 1, 1), level);
   }
   Geometry flat = random_soup(500, 8);
   for (auto& v : flat.vertices) v.z = 0.5f;
   for (auto& t : flat.triangles) (void)t;
   flat.source = "flat soup";
   std::vector<Ray> flat_rays = random_rays(flat, 1000, 9);
-  for (Precision level : kLevels) expect_same_as_brute(flat, flat_rays, {}, level);
+  for (Precision level : kLevels) expect_grid_same_as_brute(flat, flat_rays, {}, level);
 }
 
 TEST(GridTrace, MatchesBruteForceAndReferenceOnTheBunny) {
@@ -432,10 +428,10 @@ TEST(GridTrace, MatchesBruteForceAndReferenceOnTheBunny) {
   }
   std::vector<Ray> boundary = cell_boundary_rays(build_grid(g, {}), 43, 1500);
   rays.insert(rays.end(), boundary.begin(), boundary.end());
-  for (Precision level : kLevels) expect_same_as_brute(g, rays, {}, level, /*judge=*/false);
+  for (Precision level : kLevels) expect_grid_same_as_brute(g, rays, {}, level, /*judge=*/false);
   GridConfig fine;
   fine.lambda = 64.0;
-  expect_same_as_brute(g, rays, fine, Precision::robust, false);
+  expect_grid_same_as_brute(g, rays, fine, Precision::robust, false);
   // The reference judge (O(triangles) per ray) on a subset.
   std::vector<Ray> some(rays.begin(), rays.begin() + 300);
   some.insert(some.end(), rays.end() - 300, rays.end());

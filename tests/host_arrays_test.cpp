@@ -21,11 +21,7 @@
 namespace rtcl::test {
 namespace {
 
-using everywhere::kNaN;
-using everywhere::make_ray;
 using everywhere::query_name;
-
-bool same_bits(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit)) == 0; }
 
 // Origins, directions, tmin and tmax of the rays as separate arrays.
 struct SoaRays {

@@ -29,13 +29,9 @@ namespace {
 
 using glm::dvec3;
 
-bool has(const std::vector<std::string>& defines, const std::string& d) {
-  return std::find(defines.begin(), defines.end(), d) != defines.end();
-}
-
 // ---------------------------------------------------------------- scene files
 
-std::string scene_text(const std::string& object_motion, const std::string& camera_extra = "") {
+std::string motion_scene_text(const std::string& object_motion, const std::string& camera_extra = "") {
   return R"({"camera": {"position": [0, 0, 5], "look_at": [0, 0, 0])" + camera_extra +
          R"(}, "materials": {"m": {}},
              "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "m")" +
@@ -43,7 +39,7 @@ std::string scene_text(const std::string& object_motion, const std::string& came
 }
 
 TEST(MotionScene, MotionKeyIsTheEndKeyframeAndShutterIsRead) {
-  SceneDescription s = parse_scene(scene_text(R"(, "transform": {"translate": [1, 0, 0]}, "motion": {"translate": [0, 2, 0], "scale": 2})",
+  SceneDescription s = parse_scene(motion_scene_text(R"(, "transform": {"translate": [1, 0, 0]}, "motion": {"translate": [0, 2, 0], "scale": 2})",
                                    R"(, "shutter": [0.25, 0.75])"),
                         "m.json", ".");
   ASSERT_EQ(s.spheres.size(), 1u);
@@ -59,19 +55,19 @@ TEST(MotionScene, MotionKeyIsTheEndKeyframeAndShutterIsRead) {
   SceneSphere mid = sphere_at(sp, 0.5);
   EXPECT_EQ(mid.center, dvec3(1.5, 1, 0));
   EXPECT_EQ(mid.radius, 1.5);
-  EXPECT_FALSE(scene_moves(parse_scene(scene_text(""), "m.json", ".")));
+  EXPECT_FALSE(scene_moves(parse_scene(motion_scene_text(""), "m.json", ".")));
 }
 
 TEST(MotionScene, BadMotionIsOneErrorNamingTheKey) {
-  EXPECT_NE(error_of([] { parse_scene(scene_text(R"(, "motion": {"scale": 0})"), "m.json", "."); })
+  EXPECT_NE(error_of([] { parse_scene(motion_scene_text(R"(, "motion": {"scale": 0})"), "m.json", "."); })
                 .find("objects[0].motion.scale"),
             std::string::npos);
-  EXPECT_NE(error_of([] { parse_scene(scene_text(R"(, "motion": {"scale": [1, 2, 1]})"), "m.json", "."); })
+  EXPECT_NE(error_of([] { parse_scene(motion_scene_text(R"(, "motion": {"scale": [1, 2, 1]})"), "m.json", "."); })
                 .find("objects[0].motion"),
             std::string::npos);
-  EXPECT_NE(error_of([] { parse_scene(scene_text("", R"(, "shutter": [1, 0])"), "m.json", "."); }).find("camera.shutter"),
+  EXPECT_NE(error_of([] { parse_scene(motion_scene_text("", R"(, "shutter": [1, 0])"), "m.json", "."); }).find("camera.shutter"),
             std::string::npos);
-  EXPECT_NE(error_of([] { parse_scene(scene_text("", R"(, "shutter": [0])"), "m.json", "."); }).find("camera.shutter"),
+  EXPECT_NE(error_of([] { parse_scene(motion_scene_text("", R"(, "shutter": [0])"), "m.json", "."); }).find("camera.shutter"),
             std::string::npos);
 }
 
@@ -96,7 +92,7 @@ TEST(MotionScene, SingularBlendIsAnErrorNamingTheMotionKey) {
 // The broadcast form (rtcl render under mpirun) keeps both keyframes, the
 // shutter and the motion keys.
 TEST(MotionScene, SceneBytesKeepTheKeyframes) {
-  SceneDescription s = parse_scene(scene_text(R"(, "motion": {"translate": [0, 2, 0]})", R"(, "shutter": [0.1, 0.6])"), "m.json", ".");
+  SceneDescription s = parse_scene(motion_scene_text(R"(, "motion": {"translate": [0, 2, 0]})", R"(, "shutter": [0.1, 0.6])"), "m.json", ".");
   s.meshes.push_back(default_scene().meshes.at(1));
   s.meshes.back().end_transform = glm::translate(glm::dmat4(1.0), dvec3(1, 0, 0)) * s.meshes.back().transform;
   s.meshes.back().motion_key = "m.json: objects[1].motion";

@@ -29,12 +29,8 @@
 namespace rtcl::test {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
 const std::vector<std::string> kOctrees = {"octree", "octree-ptr", "octree-r"};
 
-Ray make_ray(glm::vec3 o, glm::vec3 d, float tmin = 0.0f, float tmax = kInf) {
-  return {o.x, o.y, o.z, d.x, d.y, d.z, tmin, tmax};
-}
 
 std::string describe(const Ray& r, const Hit& got, const Hit& want) {
   return "o=(" + std::to_string(r.ox) + "," + std::to_string(r.oy) + "," + std::to_string(r.oz) + ") d=(" +
@@ -46,7 +42,7 @@ std::string describe(const Ray& r, const Hit& got, const Hit& want) {
 // Each of `specs` (e.g. "octree:depth=4") and brute force answer both
 // queries alike: closest hits with the same primitive and t (bit for bit
 // unless fast), any hits with the same hit / miss.
-void expect_same_as_brute(const Geometry& g, const std::vector<Ray>& rays, const std::vector<std::string>& specs,
+void expect_octrees_same_as_brute(const Geometry& g, const std::vector<Ray>& rays, const std::vector<std::string>& specs,
                           Precision level) {
   AccelConfig config{level};
   auto brute = make_brute(test_device(), g, config);
@@ -152,7 +148,7 @@ std::array<std::vector<float>, 3> split_planes(const OctreePtr& tree) {
   return planes;
 }
 
-Geometry soup_with_spheres(std::size_t triangles, std::uint32_t seed) {
+Geometry soup_with_16_spheres(std::size_t triangles, std::uint32_t seed) {
   Geometry g = random_soup(triangles, seed);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> unit(0.0f, 1.0f);
@@ -186,7 +182,7 @@ TEST(OctreeCode, PointCodeLowerCornerRoundTripsAtEveryDepth) {
 }
 
 TEST(OctreeBuild, TableIsSortedBucketedAndListsEveryPrimitive) {
-  Geometry g = soup_with_spheres(800, 3);
+  Geometry g = soup_with_16_spheres(800, 3);
   for (bool buckets : {true, false}) {
     OctreeConfig config;
     config.max_depth = 6;
@@ -217,7 +213,7 @@ TEST(OctreeBuild, TableIsSortedBucketedAndListsEveryPrimitive) {
 // BlockBox and in the occupied box of the root child above the leaf, and so
 // does each leaf sphere's box within the cell.
 TEST(OctreeBuild, BlockBoxesAndOccupiedBoundsHoldWhatTheLeavesHold) {
-  Geometry g = soup_with_spheres(600, 11);
+  Geometry g = soup_with_16_spheres(600, 11);
   for (bool cost : {false, true}) {
     SCOPED_TRACE(cost ? "octree-r" : "octree-ptr");
     OctreePtr tree = cost ? build_octree_r(g) : build_octree_ptr(g);
@@ -324,11 +320,11 @@ TEST(OctreeBuild, OctreeRChoosesPlanesByCost) {
 }
 
 TEST(OctreeTrace, MatchesBruteForceOnSoupsAtEveryLevel) {
-  Geometry g = soup_with_spheres(1500, 11);
+  Geometry g = soup_with_16_spheres(1500, 11);
   std::vector<Ray> rays = random_rays(g, 800, 12);
   std::vector<Ray> planes = plane_rays(lattice_planes(g, 10, 5), g, 13, 1400);
   rays.insert(rays.end(), planes.begin(), planes.end());
-  for (Precision level : test_precisions()) expect_same_as_brute(g, rays, kOctrees, level);
+  for (Precision level : test_precisions()) expect_octrees_same_as_brute(g, rays, kOctrees, level);
 }
 
 // Separate tiny triangles: a cluster 2^-15 across in a unit scene, which
@@ -354,16 +350,16 @@ Geometry tiny_cluster() {
 }
 
 TEST(OctreeTrace, MatchesBruteForceOnSplitPlaneRaysOfEveryShape) {
-  Geometry g = soup_with_spheres(1000, 21);
+  Geometry g = soup_with_16_spheres(1000, 21);
   for (int depth : {0, 3}) {  // one leaf; shallow and coarse
     std::vector<Ray> rays = plane_rays(lattice_planes(g, depth, 6), g, 22 + depth, 1400);
     std::string options = ":depth=" + std::to_string(depth) + ",leaf_size=4";
-    expect_same_as_brute(g, rays, {"octree" + options, "octree-ptr" + options}, Precision::robust);
+    expect_octrees_same_as_brute(g, rays, {"octree" + options, "octree-ptr" + options}, Precision::robust);
   }
   OctreeRConfig r;
   r.leaf_size = 2;
   std::vector<Ray> rays = plane_rays(split_planes(build_octree_r(g, r)), g, 41, 1400);
-  expect_same_as_brute(g, rays, {"octree-r:leaf_size=2", "octree-r:depth=5,leaf_size=1,bins=4"}, Precision::robust);
+  expect_octrees_same_as_brute(g, rays, {"octree-r:leaf_size=2", "octree-r:depth=5,leaf_size=1,bins=4"}, Precision::robust);
 }
 
 TEST(OctreeTrace, TheDeepestTreesMatchBruteForce) {
@@ -383,7 +379,7 @@ TEST(OctreeTrace, TheDeepestTreesMatchBruteForce) {
   std::size_t deepest = 0;
   for (std::uint64_t c : tree.codes) deepest += (c & 0xf) != 0xf;  // a last digit that is not F: level 16
   EXPECT_GT(deepest, 0u);
-  expect_same_as_brute(g, rays,
+  expect_octrees_same_as_brute(g, rays,
                        {"octree:depth=16,leaf_size=1", "octree:depth=16,leaf_size=1,buckets=false",
                         "octree-ptr:depth=20,leaf_size=1", "octree-r:depth=20,leaf_size=1"},
                        Precision::robust);
@@ -416,7 +412,7 @@ TEST(OctreeTrace, DyadicQuadsSeenAlongCellEdges) {
       rays.push_back(make_ray({1.0f, float(y), float(z)}, {1, 1, 1}));  // from a corner
     }
   for (Precision level : test_precisions())
-    expect_same_as_brute(g, rays, {"octree:depth=4,leaf_size=1", "octree-ptr:depth=4,leaf_size=1", "octree-r:leaf_size=1"},
+    expect_octrees_same_as_brute(g, rays, {"octree:depth=4,leaf_size=1", "octree-ptr:depth=4,leaf_size=1", "octree-r:leaf_size=1"},
                          level);
 }
 
@@ -429,7 +425,7 @@ TEST(OctreeTrace, FlatSceneAndTinyIntervals) {
   rays.push_back(make_ray({0.25f, 0.25f, 0.0f}, {0, 0, 1}, 0.0f, 0.5f));  // tmax exactly at the plane
   rays.push_back(make_ray({0.25f, 0.25f, 0.0f}, {0, 0, 1}, 0.0f, std::nextafter(0.5f, 0.0f)));
   rays.push_back(make_ray({-1.0f, 0.25f, 0.5f}, {1, 0, 0}));  // in the plane
-  expect_same_as_brute(flat, rays, kOctrees, Precision::robust);
+  expect_octrees_same_as_brute(flat, rays, kOctrees, Precision::robust);
 }
 
 TEST(OctreeTrace, MatchesBruteForceAndReferenceOnTheBunny) {
@@ -446,7 +442,7 @@ TEST(OctreeTrace, MatchesBruteForceAndReferenceOnTheBunny) {
   }
   std::vector<Ray> planes = plane_rays(lattice_planes(g, 10, 6), g, 43, 500);
   rays.insert(rays.end(), planes.begin(), planes.end());
-  expect_same_as_brute(g, rays, kOctrees, Precision::robust);
+  expect_octrees_same_as_brute(g, rays, kOctrees, Precision::robust);
   std::vector<Ray> some(rays.begin(), rays.begin() + 150);
   some.insert(some.end(), rays.end() - 150, rays.end());
   std::vector<Hit> references = reference_closest_all(g, some);

@@ -10,12 +10,12 @@
 
 #include "rtcl/error.hpp"
 #include "support/error_of.hpp"
+#include "support/fixtures.hpp"
 #include "support/temp_dir.hpp"
 
 namespace rtcl::test {
 namespace {
 
-constexpr float inf = std::numeric_limits<float>::infinity();
 constexpr float nan = std::numeric_limits<float>::quiet_NaN();
 
 
@@ -34,16 +34,16 @@ std::int32_t int_at(const std::string& bytes, std::size_t offset) {
   return static_cast<std::int32_t>(b[0] | b[1] << 8 | b[2] << 16 | static_cast<std::uint32_t>(b[3]) << 24);
 }
 
-Ray good_ray(float x = 0.0f) { return {x, 1.0f, 2.0f, 0.0f, 0.0f, -1.0f, 0.0f, inf}; }
+Ray good_ray(float x = 0.0f) { return {x, 1.0f, 2.0f, 0.0f, 0.0f, -1.0f, 0.0f, kInf}; }
 
 TEST(RayFile, RaysRoundTripWithTheDocumentedByteLayout) {
   TempDir dir;
-  std::vector<Ray> rays = {{1, 2, 3, 4, 5, 6, 7, 8}, {-1, 0.5f, 0, 0, 1e-30f, 0, -2, inf}, {0, 0, 0, 1, 0, 0, 3, 3}};
+  std::vector<Ray> rays = {{1, 2, 3, 4, 5, 6, 7, 8}, {-1, 0.5f, 0, 0, 1e-30f, 0, -2, kInf}, {0, 0, 0, 1, 0, 0, 3, 3}};
   write_rays(dir.file("r.rays"), rays);
   std::string bytes = read_text(dir.file("r.rays"));
   ASSERT_EQ(bytes.size(), 3u * 32u);
   for (int k = 0; k < 8; ++k) EXPECT_EQ(float_at(bytes, 4 * k), static_cast<float>(k + 1)) << "field " << k;
-  EXPECT_EQ(float_at(bytes, 32 + 28), inf);  // second ray's tmax
+  EXPECT_EQ(float_at(bytes, 32 + 28), kInf);  // second ray's tmax
   std::vector<Ray> back = read_rays(dir.file("r.rays"));
   ASSERT_EQ(back.size(), rays.size());
   EXPECT_EQ(std::memcmp(back.data(), rays.data(), rays.size() * sizeof(Ray)), 0);
@@ -51,7 +51,7 @@ TEST(RayFile, RaysRoundTripWithTheDocumentedByteLayout) {
 
 TEST(RayFile, HitsRoundTripWithTheDocumentedByteLayout) {
   TempDir dir;
-  std::vector<Hit> hits = {{1.5f, 0.25f, 0.5f, 7}, {inf, 0.0f, 0.0f, -1}};
+  std::vector<Hit> hits = {{1.5f, 0.25f, 0.5f, 7}, {kInf, 0.0f, 0.0f, -1}};
   write_hits(dir.file("h.hits"), hits);
   std::string bytes = read_text(dir.file("h.hits"));
   ASSERT_EQ(bytes.size(), 32u);
@@ -59,7 +59,7 @@ TEST(RayFile, HitsRoundTripWithTheDocumentedByteLayout) {
   EXPECT_EQ(float_at(bytes, 4), 0.25f);
   EXPECT_EQ(float_at(bytes, 8), 0.5f);
   EXPECT_EQ(int_at(bytes, 12), 7);
-  EXPECT_EQ(float_at(bytes, 16), inf);
+  EXPECT_EQ(float_at(bytes, 16), kInf);
   EXPECT_EQ(int_at(bytes, 28), -1);
   std::vector<Hit> back = read_hits(dir.file("h.hits"));
   ASSERT_EQ(back.size(), 2u);
@@ -78,7 +78,7 @@ TEST(RayFile, EmptyFilesHoldZeroRecords) {
 TEST(RayFile, EdgeValuesThatAreValid) {
   TempDir dir;
   std::vector<Ray> rays = {
-      {0, 0, 0, 1e-30f, 0, 0, -inf, inf},  // tiny direction, tmin -inf
+      {0, 0, 0, 1e-30f, 0, 0, -kInf, kInf},  // tiny direction, tmin -kInf
       {0, 0, 0, 0, -1, 0, 2.0f, 2.0f},     // tmin == tmax
       {-0.0f, 0, 0, -0.0f, 0, 1, 0.0f, 0.0f},
   };
@@ -126,7 +126,7 @@ TEST(RayFileErrors, InvalidRaysAreCountedAndTheFirstIsNamed) {
   nan_origin.oy = nan;
   expect_bad(with(3, nan_origin), "1", 3, "origin has a NaN or infinite component");
   Ray inf_origin = r;
-  inf_origin.ox = -inf;
+  inf_origin.ox = -kInf;
   expect_bad(with(0, inf_origin), "1", 0, "origin has a NaN or infinite component");
   Ray nan_dir = r;
   nan_dir.dz = nan;

@@ -29,32 +29,11 @@ namespace {
 using everywhere::describe;
 using everywhere::disagreements_with_brute;
 using everywhere::expect_at_level;
-using everywhere::make_ray;
 using everywhere::query_name;
 
 // The structures Accel::refit supports, with the presplit build (a triangle
 // in several blocks, leaf boxes clipped at the build).
 const std::vector<std::string> kRefittable = {"bvh", "bvh-ploc", "bvh-packet", "bvh:presplit=1"};
-
-// Every vertex moved by a smooth field: amplitude times the box's largest
-// side, `waves` periods across the box.
-Geometry sine_deformed(Geometry g, float amplitude, float waves) {
-  const Aabb box = g.bounds();
-  const glm::vec3 extent = box.extent();
-  const float size = std::max({extent.x, extent.y, extent.z});
-  const float k = 2.0f * 3.14159265f * waves / size;
-  for (glm::vec3& v : g.vertices) {
-    const glm::vec3 p = v - box.lower;
-    v += amplitude * size * glm::vec3(std::sin(k * p.y), std::sin(k * p.z + 1.0f), std::sin(k * p.x + 2.0f));
-  }
-  return g;
-}
-
-Geometry bunny() {
-  Geometry g = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
-  validate(g);
-  return g;
-}
 
 // Rays that graze the moved primitives' boxes: axis-parallel through a
 // vertex, in the planes of a box's faces, along a box's edges (the

@@ -122,7 +122,6 @@ SceneDescription glass_slab(float ior = 1.5f) {
   return s;
 }
 
-Ray make_ray(glm::vec3 o, glm::vec3 d) { return Ray{o.x, o.y, o.z, d.x, d.y, d.z, 0.0f, INFINITY}; }
 glm::dvec3 origin(const TreeRay& r) { return {r.ray.ox, r.ray.oy, r.ray.oz}; }
 glm::dvec3 direction(const TreeRay& r) { return glm::normalize(glm::dvec3(r.ray.dx, r.ray.dy, r.ray.dz)); }
 double fresnel(double cos_i, double eta) {

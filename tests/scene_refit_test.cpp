@@ -33,22 +33,6 @@ namespace rtcl::test {
 namespace {
 
 using everywhere::expect_at_level;
-using everywhere::make_ray;
-
-// Every vertex moved by a smooth field: amplitude times the box's largest
-// side, `waves` periods across the box.
-Geometry sine_deformed(Geometry g, float amplitude, float waves) {
-  const Aabb box = g.bounds();
-  const glm::vec3 extent = box.extent();
-  const float size = std::max({extent.x, extent.y, extent.z});
-  const float k = 2.0f * 3.14159265f * waves / size;
-  for (glm::vec3& v : g.vertices) {
-    const glm::vec3 p = v - box.lower;
-    v += amplitude * size * glm::vec3(std::sin(k * p.y), std::sin(k * p.z + 1.0f), std::sin(k * p.x + 2.0f));
-  }
-  g.source += ", sine-deformed";
-  return g;
-}
 
 std::vector<float> xyz_of(const Geometry& g) {
   std::vector<float> xyz;
@@ -57,18 +41,14 @@ std::vector<float> xyz_of(const Geometry& g) {
   return xyz;
 }
 
-bool same_bits(const std::vector<Hit>& a, const std::vector<Hit>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Hit)) == 0);
-}
-
 // The world of placed meshes as one flat geometry (instance k's triangle p
 // is triangle first[k] + p), transformed in double and rounded once.
-struct World {
+struct FlatWorld {
   Geometry geometry;
   std::vector<std::uint32_t> first;
 };
-World world_of(const std::vector<const Geometry*>& meshes, const std::vector<Transform>& transforms) {
-  World w;
+FlatWorld world_of(const std::vector<const Geometry*>& meshes, const std::vector<Transform>& transforms) {
+  FlatWorld w;
   w.geometry.source = "placed meshes";
   for (std::size_t k = 0; k < meshes.size(); ++k) {
     const auto base = static_cast<std::uint32_t>(w.geometry.vertices.size());
@@ -84,7 +64,7 @@ struct Judged {
   std::vector<Ray> rays;
   std::vector<Hit> references;
 };
-Judged judged(const World& world, std::vector<Ray> rays) {
+Judged judged(const FlatWorld& world, std::vector<Ray> rays) {
   std::vector<Hit> references = reference_closest_all(world.geometry, rays);
   return {std::move(rays), std::move(references)};
 }
@@ -92,7 +72,7 @@ Judged judged(const World& world, std::vector<Ray> rays) {
 // The scene's closest and any hits with instance ids (user ids = indices
 // into the world's instances), mapped into the world and judged; ids of
 // misses must be kNoInstance.
-void expect_scene_answers(const Scene& scene, const World& world, const Judged& judged, const std::string& what) {
+void expect_scene_answers(const Scene& scene, const FlatWorld& world, const Judged& judged, const std::string& what) {
   const std::vector<Ray>& rays = judged.rays;
   const std::vector<Hit>& references = judged.references;
   std::size_t hits_seen = 0;
@@ -132,20 +112,11 @@ void expect_scene_answers(const Scene& scene, const World& world, const Judged& 
   EXPECT_GT(hits_seen, rays.size() / 5) << what;
 }
 
-Geometry bunny() {
-  static const Geometry g = [] {
-    Geometry b = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
-    b.source = "bunny";
-    return b;
-  }();
-  return g;
-}
-
 TEST(SceneRefit, OneMeshIsRefittedAndAnswersForItsNewVertices) {
   const Geometry built = bunny();
   const Geometry moved = sine_deformed(built, 0.02f, 1.5f), again = sine_deformed(built, -0.03f, 1.0f);
-  const World moved_world = world_of({&moved}, {Transform::identity()});
-  const World again_world = world_of({&again}, {Transform::identity()});
+  const FlatWorld moved_world = world_of({&moved}, {Transform::identity()});
+  const FlatWorld again_world = world_of({&again}, {Transform::identity()});
   const Judged moved_rays = judged(moved_world, random_rays(moved, 1200, 31));
   const Judged again_rays = judged(again_world, random_rays(again, 600, 32));
   for (Precision level : test_precisions()) {
@@ -201,7 +172,7 @@ TEST(SceneRefit, InstancesOfRefittedMeshesAnswerForTheirNewVertices) {
     const std::vector<Ray> some = random_rays(one.geometry, 400, 50 + k);
     rays.insert(rays.end(), some.begin(), some.end());
   }
-  const World b_moves = world(a, b_moved), both_move = world(a_moved, b_moved), neither = world(a, b);
+  const FlatWorld b_moves = world(a, b_moved), both_move = world(a_moved, b_moved), neither = world(a, b);
   const Judged b_moves_rays = judged(b_moves, rays), both_move_rays = judged(both_move, rays),
                neither_rays = judged(neither, rays);
   for (Precision level : test_precisions()) {
@@ -300,7 +271,7 @@ TEST(SceneRefit, ThePolicyDecidesBetweenRefitAndRebuild) {
     const CommitStats stats = scene.commit();
     EXPECT_EQ(stats.bottom_levels_refitted, c.refitted);
     EXPECT_EQ(stats.bottom_levels_built, 1 - c.refitted);
-    const World placed = world_of({c.moved, c.moved}, {Transform::identity(), Transform::translate(5, 0, 0)});
+    const FlatWorld placed = world_of({c.moved, c.moved}, {Transform::identity(), Transform::translate(5, 0, 0)});
     expect_scene_answers(scene, placed, judged(placed, random_rays(*c.moved, 800, 63)), what);
   }
   Scene scene(test_device());

@@ -23,22 +23,12 @@
 namespace rtcl::test {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-bool same_bits(const std::vector<Hit>& a, const std::vector<Hit>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Hit)) == 0);
-}
 
 // Rays towards the geometry from around it, ending at `tmax`.
 std::vector<Ray> rays_at(const Geometry& g, std::size_t count, std::uint32_t seed, float tmax) {
   std::vector<Ray> rays = random_rays(g, count, seed);
   for (Ray& r : rays) r.tmax = tmax;
   return rays;
-}
-
-Geometry bunny() {
-  static const Geometry g = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
-  return g;
 }
 
 TEST(Scene, OneIdentityInstanceIsTheMeshsOwnStructure) {

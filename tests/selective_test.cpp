@@ -81,7 +81,7 @@ TEST(Selective, InterpolationIsExactOnAnAffineImage) {
   EXPECT_LE(worst, 8.0 * std::numeric_limits<float>::epsilon());
 }
 
-RenderSettings small_settings() {
+RenderSettings small_sobol_settings() {
   RenderSettings s;
   s.width = 27;
   s.height = 21;
@@ -124,7 +124,7 @@ void expect_same_image(const Image& got, const Image& full, const RenderSettings
 TEST(Selective, TracingEveryPixelReproducesTheFullRender) {
   Renderer renderer(test_device(), busy_scene(), "bvh");
   for (std::uint32_t spp : {1u, 3u}) {
-    RenderSettings settings = small_settings();
+    RenderSettings settings = small_sobol_settings();
     settings.spp = spp;
     const Image full = renderer.render(settings);
     const std::uint64_t pixels = std::uint64_t(settings.width) * settings.height;

@@ -21,10 +21,6 @@
 namespace rtcl::test {
 namespace {
 
-bool has(const std::vector<std::string>& defines, const std::string& d) {
-  return std::find(defines.begin(), defines.end(), d) != defines.end();
-}
-
 TEST(Showcase, HasEveryEffect) {
   SceneDescription s = showcase_scene();
   EXPECT_TRUE(std::any_of(s.lights.begin(), s.lights.end(), [](const Light& l) { return l.area(); }));

@@ -29,7 +29,6 @@ namespace {
 using everywhere::describe;
 using everywhere::disagreements_with_brute;
 using everywhere::expect_at_level;
-using everywhere::make_ray;
 
 constexpr double kFloatUlp = 5.9604644775390625e-8;  // 2^-24
 

@@ -13,10 +13,6 @@
 
 namespace rtcl::test::everywhere {
 
-Ray make_ray(glm::vec3 o, glm::vec3 d, float tmin, float tmax) {
-  return {o.x, o.y, o.z, d.x, d.y, d.z, tmin, tmax};
-}
-
 std::string describe(const Ray& r) {
   std::ostringstream s;
   s.precision(9);

@@ -15,10 +15,6 @@
 
 namespace rtcl::test::everywhere {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-Ray make_ray(glm::vec3 o, glm::vec3 d, float tmin = 0.0f, float tmax = kInf);
 std::string describe(const Ray& r);
 std::string describe(const Hit& h);
 const char* query_name(Query q);

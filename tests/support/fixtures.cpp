@@ -3,11 +3,50 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <algorithm>
 #include <random>
 #include <string>
 
+#include "rtcl/scene/mesh_io.hpp"
+
 namespace rtcl::test {
+
+Geometry bunny() {
+  static const Geometry loaded = [] {
+    Geometry g = load_mesh(scene_path("stanford_bunny/bunny.obj")).geometry;
+    validate(g);
+    return g;
+  }();
+  return loaded;
+}
+
+bool same_bits(const Hit& a, const Hit& b) { return std::memcmp(&a, &b, sizeof(Hit)) == 0; }
+
+bool same_bits(const std::vector<Hit>& a, const std::vector<Hit>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(Hit)) == 0);
+}
+
+bool has(const std::vector<std::string>& defines, const std::string& define) {
+  return std::find(defines.begin(), defines.end(), define) != defines.end();
+}
+
+Geometry sine_deformed(Geometry g, float amplitude, float waves) {
+  const Aabb box = g.bounds();
+  const glm::vec3 extent = box.extent();
+  const float size = std::max({extent.x, extent.y, extent.z});
+  const float k = 2.0f * 3.14159265f * waves / size;
+  for (glm::vec3& v : g.vertices) {
+    const glm::vec3 p = v - box.lower;
+    v += amplitude * size * glm::vec3(std::sin(k * p.y), std::sin(k * p.z + 1.0f), std::sin(k * p.x + 2.0f));
+  }
+  g.source += ", sine-deformed";
+  return g;
+}
+
+Ray make_ray(glm::vec3 o, glm::vec3 d, float tmin, float tmax) {
+  return {o.x, o.y, o.z, d.x, d.y, d.z, tmin, tmax};
+}
 
 const Device& test_device() {
   static const Device device = [] {

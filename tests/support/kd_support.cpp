@@ -67,7 +67,7 @@ std::vector<Ray> split_plane_rays(const KdTree& tree, std::uint32_t seed, std::s
         d = target - o;
     }
     if (d == glm::vec3(0.0f)) d.x = 1.0f;
-    rays.push_back(everywhere::make_ray(o, d));
+    rays.push_back(make_ray(o, d));
   }
   return rays;
 }

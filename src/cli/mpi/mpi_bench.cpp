@@ -66,7 +66,8 @@ BenchSceneInfo scene_of(const nlohmann::json& j) {
   return {j["name"], j["triangles"], j["spheres"], j["load_ms"], j["rays_ms"], j["primary"], j["shadow"], j["diffuse"]};
 }
 
-struct StoppedByRoot {};
+// Ends a rank > 0 quietly after rank 0 reported the bad input.
+struct BenchStoppedByRoot {};
 
 void run(const MpiWorld& world, const BenchOptions& options) {
   const bool root = world.rank == 0;
@@ -85,7 +86,7 @@ void run(const MpiWorld& world, const BenchOptions& options) {
     }
   }
   broadcast_bytes(verdict, 0);
-  if (as_text(verdict) != "ok") throw StoppedByRoot{};
+  if (as_text(verdict) != "ok") throw BenchStoppedByRoot{};
   if (!root) matrix = check_bench_inputs(options, false);
   const BenchMatrix& m = *matrix;
 
@@ -176,7 +177,7 @@ void bench_distributed(const BenchOptions& options) {
     MpiWorld world;
     try {
       run(world, options);
-    } catch (const StoppedByRoot&) {
+    } catch (const BenchStoppedByRoot&) {
       stopped = true;
     } catch (const UsageError&) {
       throw;
