@@ -69,7 +69,7 @@ const BeamScene beam_scenes[] = {
      "RTCL_BENCH_BEAM_SIBENIK_REF_SPP", 1024, nullptr},
 };
 
-struct Fixture {
+struct BeamFixture {
   SceneDescription scene;
   std::uint32_t size = 0;
   std::unique_ptr<Renderer> renderer;
@@ -82,10 +82,10 @@ void maybe_write(const std::string& name, const Image& image) {
   if (dir && *dir) write_image(std::string(dir) + "/" + name + ".png", image);
 }
 
-Fixture& fixture(const BeamScene& bs) {
-  static std::map<std::string, std::unique_ptr<Fixture>> fixtures;
+BeamFixture& fixture(const BeamScene& bs) {
+  static std::map<std::string, std::unique_ptr<BeamFixture>> fixtures;
   if (auto it = fixtures.find(bs.name); it != fixtures.end()) return *it->second;
-  auto f = std::make_unique<Fixture>();
+  auto f = std::make_unique<BeamFixture>();
   f->scene = load_scene(repo_scene(bs.file));
   if (bs.ior > 0.0f)
     for (Material& m : f->scene.materials)
@@ -124,14 +124,14 @@ double masked_rmse(const Image& a, const Image& b, const std::vector<std::uint8_
   return n ? std::sqrt(sum / double(n)) : 0.0;
 }
 
-void errors(benchmark::State& state, const Fixture& f, const Image& image) {
+void errors(benchmark::State& state, const BeamFixture& f, const Image& image) {
   state.counters["rmse"] = display_rmse(image, f.reference);
   if (!f.glass.empty()) state.counters["rmse_glass"] = masked_rmse(image, f.reference, f.glass);
 }
 
 void beam_benchmark(benchmark::State& state, const BeamScene* bs, beam::CandidateCull cull) {
   try {
-    Fixture& f = fixture(*bs);
+    BeamFixture& f = fixture(*bs);
     beam::BeamSettings s;
     s.width = s.height = f.size;
     s.cull = cull;
@@ -163,7 +163,7 @@ void beam_benchmark(benchmark::State& state, const BeamScene* bs, beam::Candidat
 
 void ray_benchmark(benchmark::State& state, const BeamScene* bs, std::uint32_t spp) {
   try {
-    Fixture& f = fixture(*bs);
+    BeamFixture& f = fixture(*bs);
     RenderSettings s;
     s.width = s.height = f.size;
     s.spp = spp;
@@ -182,7 +182,7 @@ void ray_benchmark(benchmark::State& state, const BeamScene* bs, std::uint32_t s
   }
 }
 
-[[maybe_unused]] const bool registered = [] {
+[[maybe_unused]] const bool beam_registered = [] {
   for (const BeamScene& bs : beam_scenes) {
     const std::string scene = bs.name;
     benchmark::RegisterBenchmark(("beam/" + scene).c_str(), beam_benchmark, &bs, beam::CandidateCull::bvh)

@@ -89,7 +89,7 @@ class Oracle {
 #endif
 };
 
-std::shared_ptr<const BenchScene> load_scene(const SceneSpec& spec) {
+std::shared_ptr<const BenchScene> load_bench_scene(const SceneSpec& spec) {
   auto scene = std::make_shared<BenchScene>();
   scene->spec = &spec;
   auto start = std::chrono::steady_clock::now();
@@ -180,7 +180,7 @@ std::shared_ptr<const BenchScene> bench_scene(const std::string& name) {
   auto spec = std::find_if(specs.begin(), specs.end(), [&](const SceneSpec& s) { return s.name == name && !s.fit; });
   if (spec == specs.end()) throw Error("benchmark scene '" + name + "' is not defined in scene_specs()");
   resident.reset();  // release the previous scene before loading the next
-  resident = load_scene(*spec);
+  resident = load_bench_scene(*spec);
   return resident;
 }
 

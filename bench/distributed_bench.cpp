@@ -87,14 +87,14 @@ RenderSettings settings(std::uint32_t spp, Sampler sampler, std::uint32_t seed, 
   return s;
 }
 
-struct Fixture {
+struct DistributedFixture {
   std::unique_ptr<Renderer> renderer;
   Image converged;
 };
 
-Fixture& fixture() {
-  static Fixture f = [] {
-    Fixture x;
+DistributedFixture& fixture() {
+  static DistributedFixture f = [] {
+    DistributedFixture x;
     x.renderer = std::make_unique<Renderer>(bench_device(), cornell_soft(), "bvh");
     x.converged = x.renderer->render(settings(1024, Sampler::sobol, 7777));
     return x;
@@ -104,7 +104,7 @@ Fixture& fixture() {
 
 void distributed_benchmark(benchmark::State& state, Sampler sampler, std::uint32_t spp, std::uint32_t light_samples) {
   try {
-    Fixture& f = fixture();
+    DistributedFixture& f = fixture();
     f.renderer->render(settings(spp, sampler, 0, light_samples));  // warm-up
     double sq = 0.0, ms = 0.0;
     std::uint32_t seed = 1;
@@ -124,7 +124,7 @@ void distributed_benchmark(benchmark::State& state, Sampler sampler, std::uint32
   }
 }
 
-[[maybe_unused]] const bool registered = [] {
+[[maybe_unused]] const bool distributed_registered = [] {
   struct Point {
     std::uint32_t spp, light_samples;
   };

@@ -37,7 +37,7 @@ double bytes_per_triangle(std::size_t bytes, std::size_t triangles) {
   return triangles ? static_cast<double>(bytes) / static_cast<double>(triangles) : 0.0;
 }
 
-void trace_benchmark(benchmark::State& state, const std::string& scene_name, RayKind kind, EmbreeQuality quality,
+void embree_trace_benchmark(benchmark::State& state, const std::string& scene_name, RayKind kind, EmbreeQuality quality,
                      EmbreeApi api) {
   try {
     auto scene = bench_scene(scene_name);
@@ -70,7 +70,7 @@ void trace_benchmark(benchmark::State& state, const std::string& scene_name, Ray
   }
 }
 
-void build_benchmark(benchmark::State& state, const std::string& scene_name, EmbreeQuality quality) {
+void embree_build_benchmark(benchmark::State& state, const std::string& scene_name, EmbreeQuality quality) {
   try {
     auto scene = bench_scene(scene_name);
     std::size_t bytes = 0;
@@ -90,10 +90,10 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, Emb
   }
 }
 
-[[maybe_unused]] const bool registered = add_scene_hook([](const SceneSpec& spec) {
+[[maybe_unused]] const bool embree_registered = add_scene_hook([](const SceneSpec& spec) {
   for (EmbreeQuality quality : {EmbreeQuality::standard, EmbreeQuality::high}) {
     std::string name = "build/" + spec.name + "/embree" + (quality == EmbreeQuality::high ? "-high" : "");
-    benchmark::RegisterBenchmark(name.c_str(), build_benchmark, spec.name, quality)
+    benchmark::RegisterBenchmark(name.c_str(), embree_build_benchmark, spec.name, quality)
         ->UseManualTime()
         ->Unit(benchmark::kMillisecond);
   }
@@ -101,14 +101,14 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, Emb
     for (EmbreeQuality quality : {EmbreeQuality::standard, EmbreeQuality::high}) {
       std::string name = "embree/" + spec.name + "/" + ray_kind_name(kind);
       if (quality == EmbreeQuality::high) name += "/high";
-      benchmark::RegisterBenchmark(name.c_str(), trace_benchmark, spec.name, kind, quality, EmbreeApi::single)
+      benchmark::RegisterBenchmark(name.c_str(), embree_trace_benchmark, spec.name, kind, quality, EmbreeApi::single)
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond);
     }
   if (embree_has_packet8(host_threads()))
     for (RayKind kind : ray_kinds) {
       std::string name = "embree/" + spec.name + "/" + ray_kind_name(kind) + "/packet";
-      benchmark::RegisterBenchmark(name.c_str(), trace_benchmark, spec.name, kind, EmbreeQuality::standard,
+      benchmark::RegisterBenchmark(name.c_str(), embree_trace_benchmark, spec.name, kind, EmbreeQuality::standard,
                                    EmbreeApi::packet8)
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond);

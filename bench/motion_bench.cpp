@@ -20,17 +20,13 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "bench/support/timing.hpp"
 #include "bench_scenes.hpp"
 #include "rtcl/accel/bvh_motion.hpp"
 
 namespace rtcl::bench {
 namespace {
 
-double kernel_seconds(const cl::Event& event) {
-  auto start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
-  auto end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
-  return static_cast<double>(end - start) * 1e-9;
-}
 
 // The scene's geometry at shutter close for `motion`.
 Geometry moved(const Geometry& open, const std::string& motion) {
@@ -94,7 +90,7 @@ void motion_benchmark(benchmark::State& state, const std::string& scene_name, co
   }
 }
 
-[[maybe_unused]] const bool registered = [] {
+[[maybe_unused]] const bool motion_registered = [] {
   for (std::string scene : {"bunny", "sibenik"}) {
     benchmark::RegisterBenchmark(("motion/" + scene + "/static/bvh").c_str(), motion_benchmark, scene, "static", "bvh")
         ->UseManualTime()

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/support/timing.hpp"
 #include "bench_scenes.hpp"
 #include "ray_sets.hpp"
 #include "rtcl/accel.hpp"
@@ -39,11 +40,6 @@ std::size_t precision_ray_limit() {
   return v && *v ? static_cast<std::size_t>(std::strtoull(v, nullptr, 10)) : 2048;
 }
 
-double kernel_seconds(const cl::Event& event) {
-  auto start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
-  auto end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
-  return static_cast<double>(end - start) * 1e-9;
-}
 
 std::vector<Hit> trace_all(const Accel& accel, const std::vector<Ray>& rays, Query query) {
   const Device& device = accel.device();
@@ -256,7 +252,7 @@ double self_hit_rate(const Geometry& g, const Accel& accel, const std::vector<Ra
   return spawned.empty() ? 0.0 : static_cast<double>(self) / static_cast<double>(spawned.size());
 }
 
-void render_benchmark(benchmark::State& state, const RenderCase& c, Precision level) {
+void precision_render_benchmark(benchmark::State& state, const RenderCase& c, Precision level) {
   try {
     SceneDescription scene = transform_scene(default_scene(), c.transform);
     RenderSettings settings;
@@ -318,7 +314,7 @@ std::vector<std::string> traced_accels() {
     for (Precision level : kLevels)
       benchmark::RegisterBenchmark(
           ("precision/render/" + std::string(c.name) + "/" + std::string(precision_name(level))).c_str(),
-          render_benchmark, c, level)
+          precision_render_benchmark, c, level)
           ->Iterations(1)
           ->Unit(benchmark::kMillisecond);
   return true;

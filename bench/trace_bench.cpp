@@ -22,6 +22,7 @@
 #include <string>
 #include <utility>
 
+#include "bench/support/timing.hpp"
 #include "bench_scenes.hpp"
 #include "rtcl/accel.hpp"
 
@@ -94,12 +95,6 @@ class DeviceScene {
   std::map<std::pair<std::string, RayKind>, double> agreement_;
 };
 
-// Seconds between the kernel's start and end on the device.
-double kernel_seconds(const cl::Event& event) {
-  auto start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
-  auto end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
-  return static_cast<double>(end - start) * 1e-9;
-}
 
 double bytes_per_triangle(const AccelStats& stats, std::size_t triangles) {
   return triangles ? static_cast<double>(stats.device_bytes) / static_cast<double>(triangles) : 0.0;
@@ -163,7 +158,7 @@ void build_benchmark(benchmark::State& state, const std::string& scene_name, con
   }
 }
 
-[[maybe_unused]] const bool registered = add_scene_hook([](const SceneSpec& spec) {
+[[maybe_unused]] const bool trace_registered = add_scene_hook([](const SceneSpec& spec) {
   const std::vector<std::string> names = accel_names();
   for (const std::string& accel : names)
     benchmark::RegisterBenchmark(("build/" + spec.name + "/" + accel).c_str(), build_benchmark, spec.name, accel)

@@ -85,16 +85,16 @@ RenderSettings settings(const Knobs& k, std::uint32_t seed) {
   return s;
 }
 
-struct Fixture {
+struct TradeFixture {
   std::unique_ptr<Renderer> renderer;
   Image converged;
 };
 
-Fixture& fixture(const std::string& scene) {
-  static std::map<std::string, Fixture> fixtures;
+TradeFixture& fixture(const std::string& scene) {
+  static std::map<std::string, TradeFixture> fixtures;
   auto it = fixtures.find(scene);
   if (it != fixtures.end()) return it->second;
-  Fixture f;
+  TradeFixture f;
   f.renderer = std::make_unique<Renderer>(bench_device(), trade_scene(scene), "bvh");
   Knobs converged;
   converged.spp = 1024;
@@ -103,7 +103,7 @@ Fixture& fixture(const std::string& scene) {
 }
 
 // One frame; *traced: the share of pixels traced.
-Image frame(Fixture& f, const Knobs& k, std::uint32_t seed, double* traced) {
+Image frame(TradeFixture& f, const Knobs& k, std::uint32_t seed, double* traced) {
   const RenderSettings s = settings(k, seed);
   SelectiveStats stats;
   *traced = 1.0;
@@ -123,7 +123,7 @@ Image frame(Fixture& f, const Knobs& k, std::uint32_t seed, double* traced) {
 
 void trade_benchmark(benchmark::State& state, std::string scene, Knobs k) {
   try {
-    Fixture& f = fixture(scene);
+    TradeFixture& f = fixture(scene);
     double traced = 0.0;
     frame(f, k, 0, &traced);  // warm-up
     double sq = 0.0, ssim = 0.0, ms = 0.0;
@@ -164,7 +164,7 @@ void add(const std::string& scene, const Knobs& k, const std::string& tail) {
       ->Unit(benchmark::kMillisecond);
 }
 
-[[maybe_unused]] const bool registered = [] {
+[[maybe_unused]] const bool trade_registered = [] {
   for (const std::string scene : {"cornell", "sibenik"}) {
     for (Sampler sampler : {Sampler::random, Sampler::stratified, Sampler::sobol})
       for (std::uint32_t spp : {1u, 4u, 16u, 64u}) {

@@ -23,7 +23,7 @@ struct CostSetting {
   VolumeCosts costs;
 };
 
-const CostSetting settings[] = {
+const CostSetting cost_settings[] = {
     {"default", VolumeCosts{}},
     {"sphere=0", {0.0f, 64.0f, 64.0f, VolumeCosts{}.block}},
     {"kdop=0", {64.0f, 0.0f, 64.0f, VolumeCosts{}.block}},
@@ -57,10 +57,10 @@ void volume_choice(benchmark::State& state, const SceneSpec* spec, const CostSet
   }
 }
 
-[[maybe_unused]] const bool registered = [] {
+[[maybe_unused]] const bool volume_choice_registered = [] {
   for (const SceneSpec& spec : scene_specs()) {
     if (spec.stadium > 0.0f) continue;
-    for (const CostSetting& setting : settings)
+    for (const CostSetting& setting : cost_settings)
       benchmark::RegisterBenchmark(("volume_choice/" + spec.name + "/" + setting.name).c_str(), volume_choice, &spec,
                                    &setting)
           ->UseManualTime()

@@ -124,7 +124,7 @@ void volume_cost(benchmark::State& state, const char* kernel_name) {
   }
 }
 
-[[maybe_unused]] const bool registered = [] {
+[[maybe_unused]] const bool volume_cost_registered = [] {
   for (const char* kernel : {"cost_boxes8", "cost_spheres8", "cost_kdop8", "cost_obb8", "cost_triangles8"})
     benchmark::RegisterBenchmark((std::string("volume_cost/bunny/") + kernel).c_str(), volume_cost, kernel)
         ->UseManualTime()

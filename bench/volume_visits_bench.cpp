@@ -31,7 +31,7 @@ struct Setting {
   VolumeCosts costs;
 };
 
-const Setting settings[] = {
+const Setting visit_settings[] = {
     {"default", VolumeCosts{}},
     {"kdop=0", {64.0f, 0.0f, 64.0f, VolumeCosts{}.block}},
     {"obb=0", {64.0f, 64.0f, 0.0f, VolumeCosts{}.block}},
@@ -170,10 +170,10 @@ void volume_visits(benchmark::State& state, const std::string& scene_name, RayKi
   }
 }
 
-[[maybe_unused]] const bool registered = [] {
+[[maybe_unused]] const bool volume_visits_registered = [] {
   for (const char* scene : {"bunny", "sponza", "sibenik"})
     for (RayKind kind : {RayKind::primary, RayKind::diffuse})
-      for (const Setting& setting : settings)
+      for (const Setting& setting : visit_settings)
         benchmark::RegisterBenchmark(
             (std::string("volume_visits/") + scene + "/" + ray_kind_name(kind) + "/" + setting.name).c_str(),
             volume_visits, std::string(scene), kind, &setting)

@@ -5,6 +5,8 @@
 #include <chrono>
 #include <vector>
 
+#include "rtcl/opencl.hpp"
+
 namespace rtcl::bench {
 
 using Clock = std::chrono::steady_clock;
@@ -18,6 +20,13 @@ inline double ms_since(Clock::time_point start) {
 inline double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   return values[values.size() / 2];
+}
+
+// Seconds a profiled command ran on the device (its event's start to end).
+inline double kernel_seconds(const cl::Event& event) {
+  auto start = event.getProfilingInfo<CL_PROFILING_COMMAND_START>();
+  auto end = event.getProfilingInfo<CL_PROFILING_COMMAND_END>();
+  return static_cast<double>(end - start) * 1e-9;
 }
 
 }  // namespace rtcl::bench
