@@ -2,6 +2,9 @@
 
 #include <cstdint>
 
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #ifdef __linux__
 #include <sys/mman.h>
 #include <unistd.h>
@@ -39,6 +42,12 @@ void discard_pages(void* data, std::size_t bytes) noexcept {
 #else
   (void)data;
   (void)bytes;
+#endif
+}
+
+void release_free_heap_memory() noexcept {
+#ifdef __GLIBC__
+  malloc_trim(0);
 #endif
 }
 

@@ -28,6 +28,14 @@ void advise_huge_pages(void* data, std::size_t bytes) noexcept;
 // (zero on Linux); the allocation stays valid to free. Never fails.
 void discard_pages(void* data, std::size_t bytes) noexcept;
 
+// Hands the memory the C library's allocator holds free back to the
+// operating system (glibc: malloc_trim(0); elsewhere a no-op): for a build
+// whose worker threads freed large temporaries in their own allocator
+// arenas, which the next phase, on another thread, cannot reuse; without
+// it the freed pages stay resident and add to the build's peak. Takes a
+// few milliseconds on a large heap: for builds of millions of primitives.
+void release_free_heap_memory() noexcept;
+
 template <class Vector>
 void reserve_advised(Vector& v, std::size_t n) {
   v.reserve(n);

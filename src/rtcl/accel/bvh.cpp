@@ -231,11 +231,20 @@ std::vector<std::string> bvh_defines(const Geometry& geometry, const Bvh8& bvh) 
   return defines;
 }
 
+// From this many primitives a build hands its freed temporaries back
+// (release_free_heap_memory) between the binary tree and the flattening.
+constexpr std::size_t kReleaseFreeHeapPrimitives = std::size_t{1} << 18;
+
 BuiltBvh build_bvh(const Geometry& geometry, const BvhConfig& config) {
   auto start = std::chrono::steady_clock::now();
   GeometryReport report = validate(geometry, ZeroAreaTest::by_caller);
   std::size_t stored = 0;
   BuildTree tree = build_binary_bvh(geometry, config, &stored);
+  // The binary builder's temporaries, freed on its worker threads, are
+  // handed back before the flattening allocates the 8-wide tree (at 1M
+  // triangles the build's peak then reads 80-87 B per triangle instead of
+  // 92-117: docs/benchmarks.md, "Large scenes").
+  if (geometry.primitive_count() >= kReleaseFreeHeapPrimitives) release_free_heap_memory();
   report.zero_area_triangles = geometry.primitive_count() - stored;
   BuiltBvh built;
   built.bvh = flatten_bvh8(tree, geometry, flatten_options(config));
