@@ -32,8 +32,8 @@ void discard_pages(void* data, std::size_t bytes) noexcept;
 // operating system (glibc: malloc_trim(0); elsewhere a no-op): for a build
 // whose worker threads freed large temporaries in their own allocator
 // arenas, which the next phase, on another thread, cannot reuse; without
-// it the freed pages stay resident and add to the build's peak. Takes a
-// few milliseconds on a large heap: for builds of millions of primitives.
+// it the freed pages stay resident and add to the build's peak. It walks
+// every arena's free blocks: for large builds, not per call.
 void release_free_heap_memory() noexcept;
 
 template <class Vector>

@@ -242,7 +242,7 @@ BuiltBvh build_bvh(const Geometry& geometry, const BvhConfig& config) {
   BuildTree tree = build_binary_bvh(geometry, config, &stored);
   // The binary builder's temporaries, freed on its worker threads, are
   // handed back before the flattening allocates the 8-wide tree (at 1M
-  // triangles the build's peak then reads 80-87 B per triangle instead of
+  // triangles the build's peak then reads 81-89 B per triangle instead of
   // 92-117: docs/benchmarks.md, "Large scenes").
   if (geometry.primitive_count() >= kReleaseFreeHeapPrimitives) release_free_heap_memory();
   report.zero_area_triangles = geometry.primitive_count() - stored;
