@@ -141,8 +141,8 @@ __attribute__((noinline)) int instance_walk_transformed(TraceRay* s, HitState* h
 }
 
 /* Instance k against the ray: its bottom level walked with the object
- * ray, for an identity instance (RTCL_INSTANCE_LINEAR_IDENTITY and a zero
- * translation) the world ray itself, as the flat structure walks it.
+ * ray, for an identity instance (RTCL_INSTANCE_IDENTITY) the world ray
+ * itself, as the flat structure walks it.
  * Records a nearer hit in h and k in *hit_instance; returns whether it
  * recorded one (any hit: whether the instance blocks the ray). */
 inline int instance_visit(uint k, TraceRay* s, HitState* h, float tau, uint* hit_instance, INSTANCES_PARAMS) {
@@ -156,11 +156,9 @@ inline int instance_visit(uint k, TraceRay* s, HitState* h, float tau, uint* hit
 #ifdef RTCL_PRECISION_EXACT
   double exact_before = h->t_exact;
 #endif
-  global const float* t = in->translation;
-  int identity = in->flags == RTCL_INSTANCE_LINEAR_IDENTITY && t[0] == 0.0f && t[1] == 0.0f && t[2] == 0.0f;
-  int leaf = identity ? bvh_traverse(s, h, bottom_nodes, bottom_triangles, bottom_spheres)
-                      : instance_walk_transformed(s, h, in, motions, tau, bottom_nodes, bottom_triangles,
-                                                  bottom_spheres);
+  int leaf = (in->flags & RTCL_INSTANCE_IDENTITY)
+                 ? bvh_traverse(s, h, bottom_nodes, bottom_triangles, bottom_spheres)
+                 : instance_walk_transformed(s, h, in, motions, tau, bottom_nodes, bottom_triangles, bottom_spheres);
   int found = h->t_best != t_before || h->prim != prim_before;
 #ifdef RTCL_PRECISION_EXACT
   found = found || h->t_exact != exact_before;

@@ -65,6 +65,7 @@ RTCL_PROBE_FIELD(InstanceRecord, to_object) RTCL_PROBE_FIELD(InstanceRecord, to_
 RTCL_PROBE_FIELD(InstanceRecord, translation) RTCL_PROBE_FIELD(InstanceRecord, bottom)
 RTCL_PROBE_FIELD(InstanceRecord, user_id) RTCL_PROBE_FIELD(InstanceRecord, flags) RTCL_PROBE_FIELD(InstanceRecord, motion)
 RTCL_PROBE_VALUE(RTCL_INSTANCE_LINEAR_IDENTITY) RTCL_PROBE_VALUE(RTCL_INSTANCE_MOVING)
+RTCL_PROBE_VALUE(RTCL_INSTANCE_IDENTITY)
 RTCL_PROBE_RECORD(InstanceMotion)
 RTCL_PROBE_FIELD(InstanceMotion, open) RTCL_PROBE_FIELD(InstanceMotion, open[11]) RTCL_PROBE_FIELD(InstanceMotion, close)
 

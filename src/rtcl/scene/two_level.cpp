@@ -84,6 +84,9 @@ InstanceRecord instance_record(const PlacedInstance& p, std::uint32_t motion_ind
   if (identity) {
     r.flags = RTCL_INSTANCE_LINEAR_IDENTITY;
     for (int k = 0; k < 9; ++k) r.to_object[k] = k % 4 == 0 ? 1.0f : 0.0f;
+    // the world ray is the object ray: one flag test in the kernel
+    if (r.translation[0] == 0.0f && r.translation[1] == 0.0f && r.translation[2] == 0.0f)
+      r.flags |= RTCL_INSTANCE_IDENTITY;
   }
   return r;
 }
