@@ -270,9 +270,9 @@ typedef struct BottomLevel {
  * RTCL_INSTANCE_LINEAR_IDENTITY: to_object is exactly the identity and the
  * ray's direction is used as is; RTCL_INSTANCE_IDENTITY as well: the
  * translation is zero too, and the world ray is the object ray.
- * RTCL_INSTANCE_MOVING: the transform is
- * InstanceMotion `motion`'s at the ray's time (to_object and translation
- * unused). user_id is what hits report. 64 bytes. */
+ * RTCL_INSTANCE_MOVING: the transform is InstanceMotion `motion`'s at the
+ * ray's time (to_object and translation unused). user_id is what hits
+ * report. 64 bytes. */
 #define RTCL_INSTANCE_LINEAR_IDENTITY 1u
 #define RTCL_INSTANCE_MOVING 2u
 #define RTCL_INSTANCE_IDENTITY 4u
