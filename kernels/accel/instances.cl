@@ -182,34 +182,11 @@ __attribute__((noinline)) void instances_traverse(TraceRay* s, HitState* h, floa
       float8 t_entry;
       int8 hit = intersect_boxes8(node, s, h->t_best, &t_entry);
       if (rtcl_any8(hit)) {
-        /* RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST's order and ties, over the
-         * hit lanes' bits only: a top node's lanes are often mostly empty
+        /* the hit lanes' bits: a top node's lanes are often mostly empty
          * or missed, and the top level then runs 6-9% fewer instructions
-         * than with the macro's test of every lane (docs/benchmarks.md,
-         * "Instances"). The bottom levels keep the macro. */
-        uint bits = (uint)rtcl_lane_bits8(hit);
-        float lane_t[8];
-        vstore8(t_entry, 0, lane_t);
-        int near_entry = 0;
-        int base = sp, have = 0;
-        float near_t = 0.0f;
-        do { /* lanes in increasing order, as the macro's */
-          int k = 31 - (int)clz(bits & (0u - bits));
-          bits &= bits - 1u;
-          float t = lane_t[k];
-          int entry = node->child[k];
-          if (!have) {
-            have = 1;
-            near_t = t;
-            near_entry = entry;
-          } else if (RTCL_ANY_HIT || t <= near_t) {
-            RTCL_BVH8_PUSH_SORTED(near_t, near_entry)
-            near_t = t;
-            near_entry = entry;
-          } else {
-            RTCL_BVH8_PUSH_SORTED(t, entry)
-          }
-        } while (bits);
+         * than with RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST's test of every lane
+         * (docs/benchmarks.md, "Instances"); the bottom levels keep that */
+        RTCL_BVH8_PUSH_HIT_LANES_BUT_NEAREST
         ref = near_entry;
         continue;
       }

@@ -1,5 +1,5 @@
 /* The ordered push of a BVH8 node's children (kernels/accel/bvh.cl,
- * bvh_motion.cl, bvh_packet.cl, kdtree.cl): the children whose lanes `hit`
+ * bvh_motion.cl, bvh_packet.cl, kdtree.cl, instances.cl): the children whose lanes `hit`
  * holds go onto the stack (stack_t, stack_ref, top sp), kept sorted by
  * decreasing entry distance t_entry within [sp at the node, sp), so the
  * nearest child pops first; an any-hit query skips the sorting and leaves
@@ -42,26 +42,32 @@
     RTCL_BVH8_PUSH_LANE(4) RTCL_BVH8_PUSH_LANE(5) RTCL_BVH8_PUSH_LANE(6) RTCL_BVH8_PUSH_LANE(7) \
   }
 
-/* Lane k of RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST: the entry that would be on
- * top of the stack so far stays in (near_t, near_entry), out of the stack.
- * A lane not farther than it takes its place (ties: the later lane is on
- * top, as RTCL_BVH8_PUSH_SORTED leaves it); any hit: the later lane. */
-#define RTCL_BVH8_NEAR_LANE(k)                    \
-  if (hit.s##k) {                                 \
-    float t = t_entry.s##k;                       \
-    int entry = RTCL_BVH8_ENTRY(k);               \
-    if (!have) {                                  \
-      have = 1;                                   \
-      near_t = t;                                 \
-      near_entry = entry;                         \
-    } else if (RTCL_ANY_HIT || t <= near_t) {     \
-      RTCL_BVH8_PUSH_SORTED(near_t, near_entry)   \
-      near_t = t;                                 \
-      near_entry = entry;                         \
-    } else {                                      \
-      RTCL_BVH8_PUSH_SORTED(t, entry)             \
-    }                                             \
+/* A hit lane of RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST, its entry distance
+ * T and entry E, lanes taken in increasing order: the entry that would be
+ * on top of the stack so far stays in (near_t, near_entry), out of the
+ * stack. A lane not farther than it takes its place (ties: the later lane
+ * is on top, as RTCL_BVH8_PUSH_SORTED leaves it); any hit: the later
+ * lane. */
+#define RTCL_BVH8_NEAR_ENTRY(T, E)              \
+  {                                             \
+    float t = (T);                              \
+    int entry = (E);                            \
+    if (!have) {                                \
+      have = 1;                                 \
+      near_t = t;                               \
+      near_entry = entry;                       \
+    } else if (RTCL_ANY_HIT || t <= near_t) {   \
+      RTCL_BVH8_PUSH_SORTED(near_t, near_entry) \
+      near_t = t;                               \
+      near_entry = entry;                       \
+    } else {                                    \
+      RTCL_BVH8_PUSH_SORTED(t, entry)           \
+    }                                           \
   }
+
+/* Lane k of RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST. */
+#define RTCL_BVH8_NEAR_LANE(k) \
+  if (hit.s##k) RTCL_BVH8_NEAR_ENTRY(t_entry.s##k, RTCL_BVH8_ENTRY(k))
 
 /* RTCL_BVH8_PUSH_CHILDREN followed by the pop of its top, without the
  * round trip through the stack: declares int near_entry, the entry on top,
@@ -78,6 +84,25 @@
     float near_t = 0.0f;                                                                      \
     RTCL_BVH8_NEAR_LANE(0) RTCL_BVH8_NEAR_LANE(1) RTCL_BVH8_NEAR_LANE(2) RTCL_BVH8_NEAR_LANE(3) \
     RTCL_BVH8_NEAR_LANE(4) RTCL_BVH8_NEAR_LANE(5) RTCL_BVH8_NEAR_LANE(6) RTCL_BVH8_NEAR_LANE(7) \
+  }
+
+/* RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST over the hit lanes' bits
+ * (rtcl_lane_bits8, shared/ray.h): the same pushes in the same order,
+ * without a test of each lane; for nodes whose lanes are mostly empty or
+ * missed (the instances' top level, kernels/accel/instances.cl). */
+#define RTCL_BVH8_PUSH_HIT_LANES_BUT_NEAREST                                   \
+  int near_entry = 0;                                                         \
+  {                                                                           \
+    int base = sp, have = 0;                                                  \
+    float near_t = 0.0f;                                                      \
+    uint bits = (uint)rtcl_lane_bits8(hit);                                   \
+    float lane_t[8];                                                          \
+    vstore8(t_entry, 0, lane_t);                                              \
+    do {                                                                      \
+      int k = 31 - (int)clz(bits & (0u - bits)); /* the lowest set lane */    \
+      bits &= bits - 1u;                                                      \
+      RTCL_BVH8_NEAR_ENTRY(lane_t[k], RTCL_BVH8_ENTRY(k))                     \
+    } while (bits);                                                           \
   }
 
 #endif
