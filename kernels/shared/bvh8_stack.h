@@ -1,10 +1,10 @@
 /* The ordered push of a BVH8 node's children (kernels/accel/bvh.cl,
- * bvh_motion.cl, bvh_packet.cl, kdtree.cl, instances.cl): the children whose lanes `hit`
- * holds go onto the stack (stack_t, stack_ref, top sp), kept sorted by
- * decreasing entry distance t_entry within [sp at the node, sp), so the
- * nearest child pops first; an any-hit query skips the sorting and leaves
- * stack_t unwritten: its first hit ends the traversal, so its pops test no
- * entry distance. `node` is the Bvh8Node whose child[k] is pushed for
+ * bvh_motion.cl, bvh_packet.cl, kdtree.cl, instances.cl): the children
+ * whose lanes `hit` holds go onto the stack (stack_t, stack_ref, top sp),
+ * kept sorted by decreasing entry distance t_entry within [sp at the node,
+ * sp), so the nearest child pops first; an any-hit query skips the sorting
+ * and leaves stack_t unwritten: its first hit ends the traversal, so its
+ * pops test no entry distance. `node` is the Bvh8Node whose child[k] is pushed for
  * lane k. OpenCL C only. */
 #ifndef RTCL_SHARED_BVH8_STACK_H
 #define RTCL_SHARED_BVH8_STACK_H
@@ -89,7 +89,8 @@
 /* RTCL_BVH8_PUSH_CHILDREN_BUT_NEAREST over the hit lanes' bits
  * (rtcl_lane_bits8, shared/ray.h): the same pushes in the same order,
  * without a test of each lane; for nodes whose lanes are mostly empty or
- * missed (the instances' top level, kernels/accel/instances.cl). */
+ * missed (the instances' top level, kernels/accel/instances.cl). Needs
+ * some lane of `hit` set, as that macro. */
 #define RTCL_BVH8_PUSH_HIT_LANES_BUT_NEAREST                                   \
   int near_entry = 0;                                                         \
   {                                                                           \
