@@ -25,10 +25,12 @@
  * instance 0 without the top level's box test, which only culls what the
  * bottom level's root culls too.
  *
- * Stacks: the top level's traversal keeps its own (RTCL_TOP_STACK_SIZE,
- * the top tree's bound as the host computes it for the BVH) and calls
- * bvh_traverse for a bottom level, which keeps its own (RTCL_STACK_SIZE,
- * the largest bound of the bottom levels). */
+ * Stack: one for both levels, of RTCL_TOP_STACK_SIZE (the top tree's
+ * bound as the host computes it for the BVH) plus RTCL_STACK_SIZE (the
+ * largest bound of the bottom levels) entries: an identity instance's
+ * bottom level is walked inline above the top level's entries
+ * (bvh_walk), without a call and a stack of its own; a transformed one
+ * calls bvh_traverse, which keeps its own. */
 #define RTCL_INLINE_TRIANGLE_LANES
 #define RTCL_INLINE_TRIANGLE_BLOCK
 #define RTCL_INLINE_RAY_SETUP
@@ -143,9 +145,14 @@ __attribute__((noinline)) int instance_walk_transformed(TraceRay* s, HitState* h
 /* Instance k against the ray: its bottom level walked with the object
  * ray, for an identity instance (RTCL_INSTANCE_IDENTITY) the world ray
  * itself, as the flat structure walks it.
+ * The stack's entries from sp up are free for the walk.
  * Records a nearer hit in h and k in *hit_instance; returns whether it
- * recorded one (any hit: whether the instance blocks the ray). */
-inline int instance_visit(uint k, TraceRay* s, HitState* h, float tau, uint* hit_instance, INSTANCES_PARAMS) {
+ * recorded one (any hit: whether the instance blocks the ray). Inlined:
+ * as a call of its own the identity instance's walk ran about 2% more
+ * instructions per ray. */
+inline __attribute__((always_inline)) int instance_visit(uint k, TraceRay* s, HitState* h, float tau,
+                                                         uint* hit_instance, int* stack_ref, float* stack_t, int sp,
+                                                         INSTANCES_PARAMS) {
   global const InstanceRecord* in = instances + k;
   BottomLevel b = bottoms[in->bottom];
   global const Bvh8Node* bottom_nodes = nodes + b.node_offset;
@@ -157,7 +164,7 @@ inline int instance_visit(uint k, TraceRay* s, HitState* h, float tau, uint* hit
   double exact_before = h->t_exact;
 #endif
   int leaf = (in->flags & RTCL_INSTANCE_IDENTITY)
-                 ? bvh_traverse(s, h, bottom_nodes, bottom_triangles, bottom_spheres)
+                 ? bvh_walk(s, h, bottom_nodes, bottom_triangles, bottom_spheres, stack_ref, stack_t, sp)
                  : instance_walk_transformed(s, h, in, motions, tau, bottom_nodes, bottom_triangles, bottom_spheres);
   int found = h->t_best != t_before || h->prim != prim_before;
 #ifdef RTCL_PRECISION_EXACT
@@ -169,13 +176,17 @@ inline int instance_visit(uint k, TraceRay* s, HitState* h, float tau, uint* hit
 
 /* The top level's traversal (the order of kernels/accel/bvh.cl: nearest
  * child first, entries beyond the current hit skipped; any hit: the first
- * hit ends it). */
-__attribute__((noinline)) void instances_traverse(TraceRay* s, HitState* h, float tau, uint* hit_instance,
-                                                  INSTANCES_PARAMS) {
-  int stack_ref[RTCL_TOP_STACK_SIZE];
-  float stack_t[RTCL_TOP_STACK_SIZE];
+ * hit ends it). Returns the instance of the hit recorded in h (0 for a
+ * miss). */
+__attribute__((noinline)) uint instances_traverse(TraceRay* s, HitState* h, float tau, INSTANCES_PARAMS) {
+  uint hit_instance = 0;
+  int stack_ref[RTCL_TOP_STACK_SIZE + RTCL_STACK_SIZE];
+  float stack_t[RTCL_TOP_STACK_SIZE + RTCL_STACK_SIZE];
   int sp = 0;
   int ref = 0;
+#ifdef RTCL_TOP_ONE_INSTANCE
+  ref = ~0; /* a top level of one instance: its bottom level's root decides alone */
+#endif
   for (;;) {
     if (ref >= 0) {
       global const Bvh8Node* node = top + ref;
@@ -190,11 +201,12 @@ __attribute__((noinline)) void instances_traverse(TraceRay* s, HitState* h, floa
         ref = near_entry;
         continue;
       }
-    } else if (instance_visit((uint)~ref, s, h, tau, hit_instance, INSTANCES_ARGS) && RTCL_ANY_HIT) {
-      return;
+    } else if (instance_visit((uint)~ref, s, h, tau, &hit_instance, stack_ref, stack_t, sp, INSTANCES_ARGS) &&
+               RTCL_ANY_HIT) {
+      return hit_instance;
     }
     do {
-      if (sp == 0) return;
+      if (sp == 0) return hit_instance;
       --sp;
     } while (!RTCL_ANY_HIT && stack_t[sp] > h->t_best);
     ref = stack_ref[sp];
@@ -218,13 +230,7 @@ kernel void RTCL_TRACE_KERNEL_NAME(instances)(global const Ray* rays, global Hit
 #endif
   TraceRay s;
   HitState h;
-  uint hit_instance = 0;
-#ifdef RTCL_TOP_ONE_INSTANCE
-  /* a top level of one instance: its bottom level's root decides alone */
-  if (begin_trace(rays, i, &s, &h)) instance_visit(0, &s, &h, tau, &hit_instance, INSTANCES_ARGS);
-#else
-  if (begin_trace(rays, i, &s, &h)) instances_traverse(&s, &h, tau, &hit_instance, INSTANCES_ARGS);
-#endif
+  uint hit_instance = begin_trace(rays, i, &s, &h) ? instances_traverse(&s, &h, tau, INSTANCES_ARGS) : 0;
   end_trace(hits, i, &h);
   if (write_ids) instance_ids[i] = h.prim >= 0 ? instances[hit_instance].user_id : 0xffffffffu;
 }

@@ -17,7 +17,9 @@
  * holds more than, over all nodes v, the sum of
  * (children - 1) over v's ancestors plus v's children. The host computes
  * that bound from the tree (flatten_bvh8) and compiles with
- * -DRTCL_STACK_SIZE >= it.
+ * -DRTCL_STACK_SIZE >= it. bvh_traverse walks on a stack of its own;
+ * bvh_walk, the same walk, on its caller's, above the entries there (the
+ * two-level walk of an identity instance, kernels/accel/instances.cl).
  *
  * Shape for PoCL (CPU), where each work-item runs as scalar code around the
  * explicit float8 operations: the children are pushed by a per-lane branch
@@ -95,10 +97,14 @@ inline __attribute__((always_inline)) int bvh_test_leaf(int leaf, const TraceRay
   return intersect_triangles8(triangles + (leaf >> 1), s, h);
 }
 
-/* Returns the leaf that ended an any-hit traversal, else -1. */
-__attribute__((noinline)) int bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
-                                            global const TriangleBlock* triangles,
-                                            global const SphereBlock* spheres BVH_FILTER_PARAMS) {
+/* The walk from the root of (nodes, triangles, spheres) on the caller's
+ * stack (stack_ref, stack_t), above its first stack_base entries, which it
+ * leaves as they are. Returns the leaf that ended an any-hit walk, else
+ * -1. */
+inline __attribute__((always_inline)) int bvh_walk(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
+                                                   global const TriangleBlock* triangles,
+                                                   global const SphereBlock* spheres BVH_FILTER_PARAMS,
+                                                   int* stack_ref, float* stack_t, int stack_base) {
 #ifdef RTCL_BVH_SPHERES
   SphereFilterRay sphere_ray;
   sphere_filter_setup(s, &sphere_ray);
@@ -110,9 +116,7 @@ __attribute__((noinline)) int bvh_traverse(const TraceRay* s, HitState* h, globa
 #ifdef RTCL_BVH_OBB
   float obb_widen = obb_filter_setup(s);
 #endif
-  int stack_ref[RTCL_STACK_SIZE];
-  float stack_t[RTCL_STACK_SIZE]; /* entry distance of stack_ref's box */
-  int sp = 0;
+  int sp = stack_base;
   int ref = 0;
   for (;;) {
     if (ref >= 0) {
@@ -147,11 +151,21 @@ __attribute__((noinline)) int bvh_traverse(const TraceRay* s, HitState* h, globa
       if (bvh_test_leaf(leaf, s, h, triangles, spheres) && RTCL_ANY_HIT) return leaf;
     }
     do {
-      if (sp == 0) return -1;
+      if (sp == stack_base) return -1;
       --sp;
     } while (!RTCL_ANY_HIT && stack_t[sp] > h->t_best);
     ref = stack_ref[sp];
   }
+}
+
+/* bvh_walk on a stack of its own: returns the leaf that ended an any-hit
+ * traversal, else -1. */
+__attribute__((noinline)) int bvh_traverse(const TraceRay* s, HitState* h, global const Bvh8Node* nodes,
+                                            global const TriangleBlock* triangles,
+                                            global const SphereBlock* spheres BVH_FILTER_PARAMS) {
+  int stack_ref[RTCL_STACK_SIZE];
+  float stack_t[RTCL_STACK_SIZE]; /* entry distance of stack_ref's box */
+  return bvh_walk(s, h, nodes, triangles, spheres BVH_FILTER_ARGS, stack_ref, stack_t, 0);
 }
 
 #endif
