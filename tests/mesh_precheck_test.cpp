@@ -68,6 +68,33 @@ TEST(MeshPrecheck, UnknownHeaderLinesAreSkippedAsAssimpSkipsThem) {
   }
 }
 
+// Assimp 5.2 sizes an element's arrays by its first declaration and
+// writes a second declaration's instances past their end (valgrind: an
+// invalid write just after the 36-byte block of three vertices, and after
+// the 24-byte block of one face's indices; found by
+// fuzz/mesh_loader_fuzz.cpp): a name declared twice is refused, whatever
+// the counts.
+TEST(MeshPrecheck, AnElementDeclaredTwiceIsRefused) {
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  const std::string twice = "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "element vertex 6\n" + xyz +
+                            "end_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 0\n1 0 1\n0 1 1\n1 1 1\n2 2 2\n";
+  std::string e = error_of([&] { check_declared_sizes("a.ply", ".ply", twice); });
+  EXPECT_NE(e.find("a.ply: PLY header line 7: element 'vertex' is declared a second time"), std::string::npos) << e;
+  const std::string faces = "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+                            "element face 1\nproperty list uchar int vertex_indices\n"
+                            "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                            "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n";
+  e = error_of([&] { check_declared_sizes("a.ply", ".ply", faces); });
+  EXPECT_NE(e.find("a.ply: PLY header line 9: element 'face' is declared a second time"), std::string::npos) << e;
+  // distinct names, the same counts: accepted
+  EXPECT_EQ(error_of([&] {
+              check_declared_sizes("a.ply", ".ply",
+                                   "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "element extra 1\n" + xyz +
+                                       "end_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n");
+            }),
+            "");
+}
+
 TEST(MeshPrecheck, MaterialLibrariesAsAssimpNamesThem) {
   EXPECT_EQ(obj_material_libraries("v 0 0 0\nmtllib a.mtl\r\nmtllib\t my file.mtl \t\nmtllib\n# mtllib c.mtl\n"
                                    "  mtllib indented.mtl\nmtllibx x.mtl\n"),

@@ -110,7 +110,10 @@ std::optional<std::uint64_t> unsigned_number(std::string_view text) {
 // must reach end_header (Assimp 5.2 can loop forever past the end). Assimp
 // ends an element's property list at the first line that is not a property
 // and ignores property lines after it: such a file is refused, since Assimp
-// would read its data with properties missing.
+// would read its data with properties missing. An element name declared
+// twice is refused too: Assimp sizes its arrays for an element (say
+// 'vertex') by the first declaration's count and then writes the second's
+// instances past their end.
 PlyHeader parse_ply_header(const std::string& path, std::string_view bytes) {
   PlyHeader header;
   bool format_seen = false;
@@ -145,6 +148,10 @@ PlyHeader parse_ply_header(const std::string& path, std::string_view bytes) {
     } else if (w[0] == "element") {
       std::optional<std::uint64_t> count = w.size() == 3 ? unsigned_number(w[2]) : std::nullopt;
       if (!count) bad("expected 'element NAME COUNT' with a non-negative integer COUNT");
+      for (const PlyElement& e : header.elements)
+        if (e.name == w[1])
+          bad("element '" + e.name + "' is declared a second time (Assimp would write its instances past the " +
+              "arrays sized for the first)");
       header.elements.push_back({std::string(w[1]), *count, {}});
       properties_open = true;
     } else if (w[0] == "property") {
