@@ -148,8 +148,8 @@ __attribute__((noinline)) int instance_walk_transformed(TraceRay* s, HitState* h
  * The stack's entries from sp up are free for the walk.
  * Records a nearer hit in h and k in *hit_instance; returns whether it
  * recorded one (any hit: whether the instance blocks the ray). Inlined:
- * as a call of its own the identity instance's walk ran about 2% more
- * instructions per ray. */
+ * as a call of its own the identity instance's walk ran about 4% more
+ * instructions per ray (577 against 553, callgrind). */
 inline __attribute__((always_inline)) int instance_visit(uint k, TraceRay* s, HitState* h, float tau,
                                                          uint* hit_instance, int* stack_ref, float* stack_t, int sp,
                                                          INSTANCES_PARAMS) {

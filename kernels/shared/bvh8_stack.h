@@ -4,8 +4,8 @@
  * kept sorted by decreasing entry distance t_entry within [sp at the node,
  * sp), so the nearest child pops first; an any-hit query skips the sorting
  * and leaves stack_t unwritten: its first hit ends the traversal, so its
- * pops test no entry distance. `node` is the Bvh8Node whose child[k] is pushed for
- * lane k. OpenCL C only. */
+ * pops test no entry distance. `node` is the Bvh8Node whose child[k] is
+ * pushed for lane k. OpenCL C only. */
 #ifndef RTCL_SHARED_BVH8_STACK_H
 #define RTCL_SHARED_BVH8_STACK_H
 
