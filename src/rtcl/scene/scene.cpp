@@ -10,6 +10,8 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <string>
+#include <string_view>
 
 #include "rtcl/accel/accel_state.hpp"
 #include "rtcl/accel/refit.hpp"
@@ -112,28 +114,30 @@ struct Scene::State {
     return committed;
   }
 
-  MeshEntry& mesh_entry(MeshId id, const std::string& call) {
+  MeshEntry& mesh_entry(MeshId id, std::string_view call) {
     auto found = meshes.find(id.value);
     if (found == meshes.end())
-      throw Error(call + ": mesh " + std::to_string(id.value) + " does not exist (never added, or removed)");
+      throw Error(std::string(call) + ": mesh " + std::to_string(id.value) + " does not exist (never added, or removed)");
     return found->second;
   }
 
-  Instance& instance_entry(InstanceId id, const std::string& call) {
+  Instance& instance_entry(InstanceId id, std::string_view call) {
     if (id.value >= instances.size() || !instances[id.value])
-      throw Error(call + ": instance " + std::to_string(id.value) + " does not exist (never added, or removed)");
+      throw Error(std::string(call) + ": instance " + std::to_string(id.value) + " does not exist (never added, or removed)");
     return *instances[id.value];
   }
 
   // Throws unless `instance` can be placed (its mesh exists, its transforms
-  // are usable, its user id is not kNoInstance); `who` names it.
-  void check_instance(const Instance& instance, const std::string& who) {
-    mesh_entry(instance.mesh, who);
+  // are usable, its user id is not kNoInstance); who() names it (called on
+  // an error only: a scene's edits run per frame).
+  template <class Who>
+  void check_instance(const Instance& instance, const Who& who) {
+    if (meshes.find(instance.mesh.value) == meshes.end()) mesh_entry(instance.mesh, who());
     std::string problem = instance.at_close ? motion_problem(instance.transform, *instance.at_close)
                                             : transform_problem(instance.transform);
-    if (!problem.empty()) throw Error(who + ": " + problem);
+    if (!problem.empty()) throw Error(who() + ": " + problem);
     if (instance.user_id && *instance.user_id == kNoInstance)
-      throw Error(who + ": user_id " + std::to_string(kNoInstance) + " is kNoInstance, which marks a miss");
+      throw Error(who() + ": user_id " + std::to_string(kNoInstance) + " is kNoInstance, which marks a miss");
   }
 
   cl::Kernel& ids_kernel_locked() const {
@@ -227,9 +231,10 @@ InstanceId Scene::add_instance(const Instance& instance) {
   State& st = *state_;
   std::lock_guard lock(st.edit_mutex);
   const auto id = static_cast<std::uint32_t>(st.instances.size());
-  const std::string who = "Scene::add_instance (instance " + std::to_string(id) + " of mesh " +
-                          std::to_string(instance.mesh.value) + ")";
-  st.check_instance(instance, who);
+  st.check_instance(instance, [&] {
+    return "Scene::add_instance (instance " + std::to_string(id) + " of mesh " + std::to_string(instance.mesh.value) +
+           ")";
+  });
   if (id == kNoInstance) throw Error("Scene::add_instance: the scene has used every instance id");
   st.instances.push_back(instance);
   ++st.meshes.at(instance.mesh.value).instances;
@@ -242,8 +247,10 @@ void Scene::set_instance(InstanceId id, const Instance& instance) {
   State& st = *state_;
   std::lock_guard lock(st.edit_mutex);
   Instance& current = st.instance_entry(id, "Scene::set_instance");
-  st.check_instance(instance, "Scene::set_instance instance " + std::to_string(id.value) + " (mesh " +
-                                  std::to_string(instance.mesh.value) + ")");
+  st.check_instance(instance, [&] {
+    return "Scene::set_instance instance " + std::to_string(id.value) + " (mesh " +
+           std::to_string(instance.mesh.value) + ")";
+  });
   --st.meshes.at(current.mesh.value).instances;
   ++st.meshes.at(instance.mesh.value).instances;
   current = instance;
@@ -257,8 +264,10 @@ void Scene::set_transform(InstanceId id, const Transform& transform) {
   Instance changed = current;
   changed.transform = transform;
   changed.at_close.reset();
-  st.check_instance(changed, "Scene::set_transform instance " + std::to_string(id.value) + " (mesh " +
-                                 std::to_string(changed.mesh.value) + ")");
+  st.check_instance(changed, [&] {
+    return "Scene::set_transform instance " + std::to_string(id.value) + " (mesh " +
+           std::to_string(changed.mesh.value) + ")";
+  });
   current = changed;
   st.instances_changed = true;
 }

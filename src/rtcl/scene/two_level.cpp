@@ -55,10 +55,15 @@ void grow_transformed(const RootBoxes& roots, const Transform& m, glm::vec3& low
       lo[lane] = l - margin;
       hi[lane] = h + margin;
     }
+    // reduced in locals: through the references, each step waited for the
+    // store of the one before (twice the whole function's time)
+    float low = lower[i], high = upper[i];
     for (int lane = 0; lane < RTCL_BLOCK_WIDTH; ++lane) {
-      lower[i] = std::min(lower[i], lo[lane]);
-      upper[i] = std::max(upper[i], hi[lane]);
+      low = std::min(low, lo[lane]);
+      high = std::max(high, hi[lane]);
     }
+    lower[i] = low;
+    upper[i] = high;
   }
 }
 
@@ -192,12 +197,13 @@ struct TopCollapse {
 
 
 // Instances per host thread in the pass over them and in the top level's
-// build (parallel.hpp): below some 30k instances the whole top level takes
-// a few milliseconds on one thread, and a hand-off to a pooled thread that
-// is asleep (after set_transform calls, a commit's threads have slept) or
-// not running (a busy host) can cost as much as the work; larger scenes
-// gain from the threads.
-constexpr std::size_t kInstancesPerPart = 32768;
+// build (parallel.hpp). A commit's pooled threads have usually slept (after
+// the set_transform calls), and waking one took 0.1-0.3 ms here; 4096
+// instances are about 0.4 ms of one thread's work: a commit of 10k
+// instances took 2.7-3.5 ms on two threads against 4.2-4.8 ms on one
+// (docs/benchmarks.md, "Instances"), and below 4096 one thread is no
+// slower.
+constexpr std::size_t kInstancesPerPart = 4096;
 
 // The top level's RTCL_TOP_STACK_SIZE: a power of two, at least 64, so
 // that commits of a changing top level reuse one compiled program.
