@@ -56,25 +56,36 @@ inline int rtcl_is_nan(float x) { return (as_uint(x) & 0x7fffffffu) > 0x7f800000
 inline int8 rtcl_not_nan8(float8 x) { return (as_uint8(x) & 0x7fffffffu) <= 0x7f800000u; }
 inline int8 rtcl_is_finite8(float8 x) { return (as_uint8(x) & 0x7f800000u) != 0x7f800000u; }
 
+/* any() for comparison results (lanes 0 or -1), written as an OR reduction
+ * tested against zero: one vptest on AVX, where any()'s sign-bit reduction
+ * becomes a chain of shuffles. */
+inline int rtcl_any8(int8 m) {
+  uint8 u = as_uint8(m);
+  uint4 o4 = u.lo | u.hi;
+  uint2 o2 = o4.lo | o4.hi;
+  return (o2.lo | o2.hi) != 0u;
+}
+
 /* The invalid-ray rule (docs/robustness.md): NaN or ±inf in any origin
  * or direction component, a zero direction, a NaN tmin or tmax, or
- * tmin > tmax: the ray reports a miss. */
-/* The rule as one expression over scalars or vectors, from the bit tests
- * above: FINITE / NOT_NAN the scalar or lane-wise ones, AS_UINT as_uint or
- * as_uint8 (scalars give 1 where valid, vectors -1 in the valid lanes). */
-#define RTCL_RAY_VALID(FINITE, NOT_NAN, AS_UINT, ox, oy, oz, dx, dy, dz, tmin, tmax)                   \
-  (FINITE(ox) & FINITE(oy) & FINITE(oz) & FINITE(dx) & FINITE(dy) & FINITE(dz) &                      \
-   (((AS_UINT(dx) | AS_UINT(dy) | AS_UINT(dz)) & 0x7fffffffu) != 0u) & NOT_NAN(tmin) & NOT_NAN(tmax) & \
-   ((tmin) <= (tmax)))
-
+ * tmin > tmax: the ray reports a miss. For one ray, its fields in eight
+ * lanes in Ray's order: the origin's and direction's exponent bits, and
+ * tmin's and tmax's magnitude bits, against their limits in one compare
+ * (about 10 instructions less per ray than the test of each field by
+ * itself, callgrind); then a nonzero direction and tmin <= tmax. */
 inline int rtcl_ray_valid(float ox, float oy, float oz, float dx, float dy, float dz, float tmin, float tmax) {
-  return RTCL_RAY_VALID(rtcl_is_finite, !rtcl_is_nan, as_uint, ox, oy, oz, dx, dy, dz, tmin, tmax);
+  const int e = 0x7f800000; /* exponent bits: all set for inf and NaN */
+  int8 bits = as_int8((float8)(ox, oy, oz, dx, dy, dz, tmin, tmax)) & (int8)(e, e, e, e, e, e, 0x7fffffff, 0x7fffffff);
+  int8 beyond = bits >= (int8)(e, e, e, e, e, e, e + 1, e + 1);
+  return !rtcl_any8(beyond) & (((as_uint(dx) | as_uint(dy) | as_uint(dz)) & 0x7fffffffu) != 0u) & (tmin <= tmax);
 }
 
 /* The same for eight rays in lanes: -1 in the valid lanes. */
 inline int8 rtcl_ray_valid8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, float8 tmin,
                             float8 tmax) {
-  return RTCL_RAY_VALID(rtcl_is_finite8, rtcl_not_nan8, as_uint8, ox, oy, oz, dx, dy, dz, tmin, tmax);
+  return rtcl_is_finite8(ox) & rtcl_is_finite8(oy) & rtcl_is_finite8(oz) & rtcl_is_finite8(dx) &
+         rtcl_is_finite8(dy) & rtcl_is_finite8(dz) & (((as_uint8(dx) | as_uint8(dy) | as_uint8(dz)) & 0x7fffffffu) != 0u) &
+         rtcl_not_nan8(tmin) & rtcl_not_nan8(tmax) & (tmin <= tmax);
 }
 
 /* How trace_ray_setup is compiled: a plain inline function, which PoCL
@@ -186,15 +197,6 @@ inline float hit_state_t(const HitState* h) {
 inline float8 rtcl_fmax8(float8 a, float8 b) { return select(b, a, a > b); }
 inline float8 rtcl_fmin8(float8 a, float8 b) { return select(b, a, a < b); }
 
-/* any() for comparison results (lanes 0 or -1), written as an OR reduction
- * tested against zero: one vptest on AVX, where any()'s sign-bit reduction
- * becomes a chain of shuffles. */
-inline int rtcl_any8(int8 m) {
-  uint8 u = as_uint8(m);
-  uint4 o4 = u.lo | u.hi;
-  uint2 o2 = o4.lo | o4.hi;
-  return (o2.lo | o2.hi) != 0u;
-}
 
 /* Min / max over the lanes by compares, for lanes that are never NaN:
  * fmin / fmax's NaN rules cost a compare and a blend more per step. */
