@@ -84,8 +84,9 @@ inline int rtcl_ray_valid(float ox, float oy, float oz, float dx, float dy, floa
 inline int8 rtcl_ray_valid8(float8 ox, float8 oy, float8 oz, float8 dx, float8 dy, float8 dz, float8 tmin,
                             float8 tmax) {
   return rtcl_is_finite8(ox) & rtcl_is_finite8(oy) & rtcl_is_finite8(oz) & rtcl_is_finite8(dx) &
-         rtcl_is_finite8(dy) & rtcl_is_finite8(dz) & (((as_uint8(dx) | as_uint8(dy) | as_uint8(dz)) & 0x7fffffffu) != 0u) &
-         rtcl_not_nan8(tmin) & rtcl_not_nan8(tmax) & (tmin <= tmax);
+         rtcl_is_finite8(dy) & rtcl_is_finite8(dz) &
+         (((as_uint8(dx) | as_uint8(dy) | as_uint8(dz)) & 0x7fffffffu) != 0u) & rtcl_not_nan8(tmin) &
+         rtcl_not_nan8(tmax) & (tmin <= tmax);
 }
 
 /* How trace_ray_setup is compiled: a plain inline function, which PoCL
@@ -196,7 +197,6 @@ inline float hit_state_t(const HitState* h) {
 
 inline float8 rtcl_fmax8(float8 a, float8 b) { return select(b, a, a > b); }
 inline float8 rtcl_fmin8(float8 a, float8 b) { return select(b, a, a < b); }
-
 
 /* Min / max over the lanes by compares, for lanes that are never NaN:
  * fmin / fmax's NaN rules cost a compare and a blend more per step. */

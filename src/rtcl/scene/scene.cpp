@@ -117,13 +117,15 @@ struct Scene::State {
   MeshEntry& mesh_entry(MeshId id, std::string_view call) {
     auto found = meshes.find(id.value);
     if (found == meshes.end())
-      throw Error(std::string(call) + ": mesh " + std::to_string(id.value) + " does not exist (never added, or removed)");
+      throw Error(std::string(call) + ": mesh " + std::to_string(id.value) +
+                  " does not exist (never added, or removed)");
     return found->second;
   }
 
   Instance& instance_entry(InstanceId id, std::string_view call) {
     if (id.value >= instances.size() || !instances[id.value])
-      throw Error(std::string(call) + ": instance " + std::to_string(id.value) + " does not exist (never added, or removed)");
+      throw Error(std::string(call) + ": instance " + std::to_string(id.value) +
+                  " does not exist (never added, or removed)");
     return *instances[id.value];
   }
 
@@ -132,7 +134,7 @@ struct Scene::State {
   // an error only: a scene's edits run per frame).
   template <class Who>
   void check_instance(const Instance& instance, const Who& who) {
-    if (meshes.find(instance.mesh.value) == meshes.end()) mesh_entry(instance.mesh, who());
+    if (!meshes.contains(instance.mesh.value)) mesh_entry(instance.mesh, who());  // throws its error
     std::string problem = instance.at_close ? motion_problem(instance.transform, *instance.at_close)
                                             : transform_problem(instance.transform);
     if (!problem.empty()) throw Error(who() + ": " + problem);

@@ -201,8 +201,7 @@ struct TopCollapse {
 // the set_transform calls), and waking one took 0.1-0.3 ms here; 4096
 // instances are about 0.4 ms of one thread's work: a commit of 10k
 // instances took 2.7-3.5 ms on two threads against 4.2-4.8 ms on one
-// (docs/benchmarks.md, "Instances"), and below 4096 one thread is no
-// slower.
+// (docs/benchmarks.md, "Instances"); two threads from 8192 instances.
 constexpr std::size_t kInstancesPerPart = 4096;
 
 // The top level's RTCL_TOP_STACK_SIZE: a power of two, at least 64, so
